@@ -1,0 +1,61 @@
+"""The Typer application: thin commands that parse options, call the core, render, and exit.
+
+Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad input gets a one-line
+``ar3cli: error: ...`` on stderr, never a traceback; set ``AR3CLI_DEBUG=1`` to see one for bugs).
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+
+import typer
+
+from ar3cli import __version__
+from ar3cli.commands.install_check import install_check
+from ar3cli.errors import EXIT_USAGE, UserError
+
+app = typer.Typer(
+    name="ar3cli",
+    help="Diagnose, fix and sim-check robot description files (URDF and xacro) with PyBullet.",
+    no_args_is_help=True,
+    rich_markup_mode="rich",
+    pretty_exceptions_enable=False,
+    add_completion=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+def _version_callback(value: bool) -> None:
+    if value:
+        print(f"ar3cli {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(False, "--version", callback=_version_callback, is_eager=True,
+                                 help="Print the version and exit."),
+) -> None:
+    """Diagnose, fix and sim-check robot description files (URDF and xacro) with PyBullet."""
+
+
+app.command("install-check")(install_check)
+
+
+def main(argv: list[str] | None = None) -> None:
+    """Console entry point: run the app and turn UserError into a one-line message + exit code."""
+    try:
+        app(args=argv, prog_name="ar3cli")
+    except UserError as exc:
+        print(f"ar3cli: error: {exc.message}", file=sys.stderr)
+        sys.exit(exc.exit_code)
+    except KeyboardInterrupt:
+        print("ar3cli: interrupted", file=sys.stderr)
+        sys.exit(130)
+    except Exception as exc:  # a bug in ar3cli: one line unless debugging
+        if os.environ.get("AR3CLI_DEBUG"):
+            raise
+        print(f"ar3cli: internal error: {type(exc).__name__}: {exc} (rerun with AR3CLI_DEBUG=1 for a traceback "
+              "and report it)", file=sys.stderr)
+        sys.exit(EXIT_USAGE + 1)

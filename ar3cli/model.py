@@ -1,0 +1,373 @@
+"""Load a ``.urdf`` or ``.xacro`` file once into a :class:`Model` that every command reads.
+
+The Model keeps the parsed lxml tree (each element knows its source line), typed views of links,
+joints, inertials and geometry, mesh URIs resolved to paths (with the places tried), and the
+:class:`~ar3cli.xmlsource.Quirk` list of everything odd about the file. Values that do not parse
+are kept as ``None`` next to their raw text, so the linter can report them while the other
+commands still load the file. Nothing here imports pybullet, trimesh or yourdfpy.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+from ar3cli import xacro_expand, xmlsource
+from ar3cli.errors import UserError
+from ar3cli.packages import PackageResolver, Resolution
+from ar3cli.xmlsource import Quirk
+
+Vec3 = tuple[float, float, float]
+MOVING_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar", "floating")
+"""Joint types whose child link moves relative to its parent."""
+
+
+def parse_floats(text: str | None, count: int | None = None) -> tuple[float, ...] | None:
+    """Parse whitespace-separated numbers; ``None`` when missing, non-numeric or the wrong count.
+
+    NaN and inf parse (they are numbers to Python) and are left for the linter to flag.
+    """
+    if text is None:
+        return None
+    try:
+        values = tuple(float(part) for part in text.split())
+    except ValueError:
+        return None
+    if count is not None and len(values) != count:
+        return None
+    return values
+
+
+def parse_float(text: str | None) -> float | None:
+    """One number, or ``None`` when missing or malformed."""
+    values = parse_floats(text, 1)
+    return values[0] if values else None
+
+
+@dataclass(frozen=True)
+class Origin:
+    """An ``<origin>``; identity when the element is absent or malformed."""
+
+    xyz: Vec3 = (0.0, 0.0, 0.0)
+    rpy: Vec3 = (0.0, 0.0, 0.0)
+    element: Any = None
+
+    @classmethod
+    def from_parent(cls, parent) -> Origin:
+        element = parent.find("origin") if parent is not None else None
+        if element is None:
+            return cls()
+        xyz = parse_floats(element.get("xyz", "0 0 0"), 3) or (0.0, 0.0, 0.0)
+        rpy = parse_floats(element.get("rpy", "0 0 0"), 3) or (0.0, 0.0, 0.0)
+        return cls(xyz, rpy, element)  # type: ignore[arg-type]
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """The shape inside a ``<visual>`` or ``<collision>``.
+
+    ``kind`` is box / cylinder / sphere / capsule / mesh, or ``None`` when the element is missing
+    or of an unknown type. ``params`` holds the parsed dimensions (``size``, ``radius``,
+    ``length``, ``scale``) and ``resolution`` where a mesh file was found.
+    """
+
+    kind: str | None
+    params: Mapping[str, Any]
+    element: Any
+    filename: str | None = None
+    resolution: Resolution | None = None
+
+
+@dataclass(frozen=True)
+class Shape:
+    """A ``<visual>`` or ``<collision>`` element with its origin and geometry."""
+
+    role: str
+    origin: Origin
+    geometry: Geometry
+    element: Any
+
+
+@dataclass(frozen=True)
+class Inertial:
+    """An ``<inertial>``: ``mass`` and ``tensor`` (ixx, ixy, ixz, iyy, iyz, izz) are None when malformed."""
+
+    origin: Origin
+    mass: float | None
+    tensor: tuple[float, float, float, float, float, float] | None
+    element: Any
+
+    def matrix(self) -> list[list[float]] | None:
+        """The symmetric 3x3 tensor as nested lists, or None."""
+        if self.tensor is None:
+            return None
+        ixx, ixy, ixz, iyy, iyz, izz = self.tensor
+        return [[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]]
+
+
+@dataclass(frozen=True)
+class Limit:
+    """A joint ``<limit>``; each value None when absent or malformed."""
+
+    lower: float | None
+    upper: float | None
+    effort: float | None
+    velocity: float | None
+    element: Any
+
+
+@dataclass(frozen=True)
+class Mimic:
+    joint: str
+    multiplier: float
+    offset: float
+    element: Any
+
+
+@dataclass(frozen=True)
+class Link:
+    name: str
+    inertial: Inertial | None
+    visuals: tuple[Shape, ...]
+    collisions: tuple[Shape, ...]
+    element: Any
+
+    @property
+    def line(self) -> int:
+        return self.element.sourceline or 0
+
+    @property
+    def has_geometry(self) -> bool:
+        return bool(self.visuals or self.collisions)
+
+
+@dataclass(frozen=True)
+class Joint:
+    name: str
+    type: str
+    parent: str | None
+    child: str | None
+    origin: Origin
+    axis: Vec3
+    axis_given: bool
+    limit: Limit | None
+    mimic: Mimic | None
+    element: Any
+
+    @property
+    def line(self) -> int:
+        return self.element.sourceline or 0
+
+    @property
+    def moves(self) -> bool:
+        return self.type in MOVING_JOINT_TYPES
+
+
+@dataclass
+class Model:
+    """A robot description loaded from one file. Build it with :func:`load_model`."""
+
+    path: Path
+    root: Any
+    source_bytes: bytes
+    xml_bytes: bytes
+    is_xacro: bool
+    resolver: PackageResolver
+    quirks: list[Quirk] = field(default_factory=list)
+    links: list[Link] = field(default_factory=list)
+    joints: list[Joint] = field(default_factory=list)
+
+    # ---- lookups -------------------------------------------------------------------------
+    @property
+    def name(self) -> str | None:
+        return self.root.get("name")
+
+    def link(self, name: str) -> Link | None:
+        return self._links_by_name.get(name)
+
+    def joint(self, name: str) -> Joint | None:
+        return self._joints_by_name.get(name)
+
+    @cached_property
+    def _links_by_name(self) -> dict[str, Link]:
+        return {link.name: link for link in reversed(self.links)}
+
+    @cached_property
+    def _joints_by_name(self) -> dict[str, Joint]:
+        return {joint.name: joint for joint in reversed(self.joints)}
+
+    def parent_joint(self, link_name: str) -> Joint | None:
+        """The joint whose child is ``link_name`` (the first one, if the file has several)."""
+        return next((j for j in self.joints if j.child == link_name), None)
+
+    def child_joints(self, link_name: str) -> list[Joint]:
+        return [j for j in self.joints if j.parent == link_name]
+
+    def root_links(self) -> list[Link]:
+        """Links that are no joint's child. A well-formed robot has exactly one."""
+        children = {j.child for j in self.joints}
+        return [link for link in self.links if link.name not in children]
+
+    @property
+    def root_link(self) -> Link:
+        """The single root link; raises UserError when the tree has none or several."""
+        roots = self.root_links()
+        if len(roots) != 1:
+            names = ", ".join(link.name for link in roots) or "none"
+            raise UserError(f"{self.path}: expected one root link, found {len(roots)} ({names}); "
+                            "run ar3cli lint-urdf for details")
+        return roots[0]
+
+    def movable_joints(self) -> list[Joint]:
+        return [j for j in self.joints if j.moves]
+
+    def meshes(self) -> Iterator[tuple[Link, Shape]]:
+        """Every (link, shape) whose geometry is a mesh."""
+        for link in self.links:
+            for shape in (*link.visuals, *link.collisions):
+                if shape.geometry.kind == "mesh":
+                    yield link, shape
+
+    # ---- text positions ----------------------------------------------------------------------
+    @cached_property
+    def text_lines(self) -> list[str]:
+        """Lines of the parsed document (the expanded URDF for xacro files)."""
+        return xmlsource.decode_text(self.xml_bytes).splitlines()
+
+    def column_of(self, element) -> int:
+        """1-based column of the element's start tag on its line (1 when it cannot be found)."""
+        line = element.sourceline or 0
+        if not 1 <= line <= len(self.text_lines):
+            return 1
+        index = self.text_lines[line - 1].find(f"<{element.tag}")
+        return index + 1 if index >= 0 else 1
+
+
+def load_model(
+    path: str | Path,
+    package_paths: Mapping[str, Path] | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+) -> Model:
+    """Read, expand (xacro), parse and index one robot file; bad input raises :class:`UserError`."""
+    path = Path(path)
+    source = xmlsource.read_bytes(path)
+    if not source.strip(b"\x00 \t\r\n"):
+        raise UserError(f"{path}: file is empty")
+    resolver = PackageResolver(path.parent, package_paths)
+    xmlsource.refuse_entities(source, path)
+    quirks: list[Quirk] = []
+    if xacro_expand.is_xacro(path):
+        _, quirks = xmlsource.normalize(source)
+        xml_bytes = xacro_expand.expand(path, dict(xacro_args or {}), resolver)
+        xmlsource.refuse_entities(xml_bytes, path)  # an included file may declare some
+    else:
+        xml_bytes, quirks = xmlsource.normalize(source)
+    root, parse_quirks = xmlsource.parse(xml_bytes, path)
+    quirks.extend(parse_quirks)
+    if not isinstance(root.tag, str) or root.tag != "robot":
+        raise UserError(f"{path}:{root.sourceline or 1}: root element is <{root.tag}>, expected <robot>; "
+                        "is this a URDF file?")
+    return Model(path=path, root=root, source_bytes=source, xml_bytes=xml_bytes,
+                 is_xacro=xacro_expand.is_xacro(path), resolver=resolver, quirks=quirks,
+                 links=[_read_link(element, resolver) for element in root.findall("link")],
+                 joints=[_read_joint(element) for element in root.findall("joint")])
+
+
+def _read_link(element, resolver: PackageResolver) -> Link:
+    inertial_element = element.find("inertial")
+    inertial = None
+    if inertial_element is not None:
+        mass_element = inertial_element.find("mass")
+        tensor_element = inertial_element.find("inertia")
+        tensor = None
+        if tensor_element is not None:
+            values = [parse_float(tensor_element.get(key)) for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
+            if all(v is not None for v in values):
+                tensor = tuple(values)  # type: ignore[assignment]
+        inertial = Inertial(
+            origin=Origin.from_parent(inertial_element),
+            mass=parse_float(mass_element.get("value")) if mass_element is not None else None,
+            tensor=tensor,
+            element=inertial_element,
+        )
+    return Link(
+        name=element.get("name", ""),
+        inertial=inertial,
+        visuals=tuple(_read_shape(e, "visual", resolver) for e in element.findall("visual")),
+        collisions=tuple(_read_shape(e, "collision", resolver) for e in element.findall("collision")),
+        element=element,
+    )
+
+
+def _read_shape(element, role: str, resolver: PackageResolver) -> Shape:
+    return Shape(role=role, origin=Origin.from_parent(element), geometry=_read_geometry(element, resolver),
+                 element=element)
+
+
+def _read_geometry(shape_element, resolver: PackageResolver) -> Geometry:
+    container = shape_element.find("geometry")
+    if container is None:
+        return Geometry(None, {}, None)
+    children = [child for child in container if isinstance(child.tag, str)]
+    if not children:
+        return Geometry(None, {}, container)
+    element = children[0]
+    kind = element.tag
+    if kind == "box":
+        return Geometry(kind, {"size": parse_floats(element.get("size"), 3)}, element)
+    if kind in ("cylinder", "capsule"):
+        return Geometry(kind, {"radius": parse_float(element.get("radius")),
+                               "length": parse_float(element.get("length"))}, element)
+    if kind == "sphere":
+        return Geometry(kind, {"radius": parse_float(element.get("radius"))}, element)
+    if kind == "mesh":
+        filename = element.get("filename")
+        scale_text = element.get("scale")
+        scale: tuple[float, ...] | None = (1.0, 1.0, 1.0)
+        if scale_text is not None:
+            scale = parse_floats(scale_text)
+            if scale is not None and len(scale) == 1:
+                scale = scale * 3  # pybullet accepts one number (with a warning)
+            elif scale is not None and len(scale) != 3:
+                scale = None
+        resolution = resolver.resolve(filename) if filename else None
+        return Geometry(kind, {"scale": scale}, element, filename, resolution)
+    return Geometry(None, {"tag": kind}, element)
+
+
+def _read_joint(element) -> Joint:
+    limit_element = element.find("limit")
+    limit = None
+    if limit_element is not None:
+        limit = Limit(*(parse_float(limit_element.get(key)) for key in ("lower", "upper", "effort", "velocity")),
+                      element=limit_element)
+    axis_element = element.find("axis")
+    axis = parse_floats(axis_element.get("xyz"), 3) if axis_element is not None else None
+    mimic_element = element.find("mimic")
+    mimic = None
+    if mimic_element is not None:
+        mimic = Mimic(mimic_element.get("joint", ""),
+                      _finite_or(parse_float(mimic_element.get("multiplier")), 1.0),
+                      _finite_or(parse_float(mimic_element.get("offset")), 0.0), mimic_element)
+    parent = element.find("parent")
+    child = element.find("child")
+    return Joint(
+        name=element.get("name", ""),
+        type=element.get("type", ""),
+        parent=parent.get("link") if parent is not None else None,
+        child=child.get("link") if child is not None else None,
+        origin=Origin.from_parent(element),
+        axis=axis or (1.0, 0.0, 0.0),  # type: ignore[arg-type]
+        axis_given=axis_element is not None,
+        limit=limit,
+        mimic=mimic,
+        element=element,
+    )
+
+
+def _finite_or(value: float | None, default: float) -> float:
+    return value if value is not None and math.isfinite(value) else default

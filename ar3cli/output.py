@@ -1,0 +1,142 @@
+"""The one output layer: every command hands it a :class:`Report` and a format.
+
+Text goes to a rich console: tables with colour on a terminal, plain ASCII tables without colour
+when stdout is not a terminal or ``NO_COLOR`` is set. JSON goes to stdout alone, so
+``ar3cli ... --format json | jq`` always works; progress and logs go to stderr.
+Lint's extra formats (sarif, github, markdown) live in their own modules and use the same Report.
+"""
+
+from __future__ import annotations
+
+import enum
+import json
+import math
+import os
+import sys
+from dataclasses import dataclass, field
+from typing import Any
+
+
+class OutputFormat(str, enum.Enum):
+    """Formats every command supports."""
+
+    text = "text"
+    json = "json"
+
+
+STATUS_STYLES = {
+    "ok": "green", "pass": "green", "passed": "green", "success": "green",
+    "info": "blue", "warn": "yellow", "warning": "yellow",
+    "fail": "red", "failed": "red", "error": "bold red",
+}
+
+
+@dataclass
+class Table:
+    """A titled table: ``rows`` hold plain values; cells in a ``status_column`` get coloured."""
+
+    title: str
+    columns: list[str]
+    rows: list[list[Any]] = field(default_factory=list)
+    caption: str = ""
+    status_column: str | None = None
+    numeric_columns: tuple[str, ...] = ()
+
+
+@dataclass
+class Report:
+    """What a command found: ``data`` is the JSON document, ``tables``/``lines`` its text form."""
+
+    data: dict[str, Any]
+    tables: list[Table] = field(default_factory=list)
+    lines: list[str] = field(default_factory=list)
+    ok: bool = True
+
+
+def _plain() -> bool:
+    return bool(os.environ.get("NO_COLOR")) or not sys.stdout.isatty()
+
+
+def console(stderr: bool = False):
+    """A rich Console for stdout (or stderr): no colour and ASCII boxes when not a terminal."""
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    plain = bool(os.environ.get("NO_COLOR")) or not stream.isatty()
+    return Console(file=stream, no_color=plain, highlight=False, soft_wrap=False,
+                   width=None if stream.isatty() else 160, safe_box=True,
+                   force_terminal=False if plain else None)
+
+
+def format_cell(value: Any) -> str:
+    """Numbers compactly (4 significant digits, scientific when tiny/huge); None as a dash."""
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        if value == 0 or not math.isfinite(value):
+            return str(value)
+        magnitude = abs(value)
+        return f"{value:.4g}" if 1e-3 <= magnitude < 1e5 else f"{value:.3e}"
+    return str(value)
+
+
+def render_table(table: Table, out=None) -> None:
+    """Print one :class:`Table` through rich."""
+    from rich import box
+    from rich.table import Table as RichTable
+    from rich.text import Text
+
+    out = out or console()
+    plain = _plain()
+    rich_table = RichTable(title=table.title or None, caption=table.caption or None,
+                           box=box.ASCII2 if plain else box.ROUNDED, title_justify="left",
+                           caption_justify="left", header_style="" if plain else "bold")
+    for column in table.columns:
+        rich_table.add_column(column, justify="right" if column in table.numeric_columns else "left",
+                              overflow="fold")
+    status_index = table.columns.index(table.status_column) if table.status_column in table.columns else -1
+    for row in table.rows:
+        cells = []
+        for index, value in enumerate(row):
+            text = format_cell(value)
+            style = STATUS_STYLES.get(text.lower(), "") if index == status_index and not plain else ""
+            cells.append(Text(text, style=style))
+        rich_table.add_row(*cells)
+    out.print(rich_table)
+
+
+def emit_json(data: Any) -> None:
+    """Write one JSON document to stdout, and nothing else."""
+    sys.stdout.write(json.dumps(data, indent=2, default=_json_default, allow_nan=False) + "\n")
+    sys.stdout.flush()
+
+
+def _json_default(value: Any) -> Any:
+    if hasattr(value, "tolist"):
+        return value.tolist()
+    if hasattr(value, "item"):
+        return value.item()
+    if isinstance(value, enum.Enum):
+        return value.value
+    if hasattr(value, "__fspath__"):
+        return os.fspath(value)
+    raise TypeError(f"cannot serialise {type(value).__name__}")
+
+
+def render(report: Report, fmt: OutputFormat | str) -> None:
+    """Render ``report`` in ``fmt``: all tables then the summary lines, or the JSON document."""
+    if OutputFormat(fmt) is OutputFormat.json:
+        emit_json(report.data)
+        return
+    out = console()
+    for table in report.tables:
+        render_table(table, out)
+    for line in report.lines:
+        out.print(line, markup=False)
+
+
+def log(message: str) -> None:
+    """A progress/log line on stderr (never on stdout, which may carry JSON)."""
+    print(message, file=sys.stderr, flush=True)

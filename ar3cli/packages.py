@@ -1,0 +1,166 @@
+"""Resolve mesh URIs (relative, absolute, ``file://``, ``package://``) to files on disk.
+
+ROS tools resolve ``package://NAME/...`` through a ROS installation; most ar3cli users have none.
+So the search is explicit, in this order, and every place tried is remembered for the error:
+
+1. ``--package-path NAME=DIR`` given on the command line (DIR is the package folder itself);
+2. each entry of ``ROS_PACKAGE_PATH`` (``ENTRY/NAME``, or ENTRY itself when it is the package);
+3. each prefix of ``AMENT_PREFIX_PATH`` (``PREFIX/share/NAME``);
+4. the nearest ancestor folder of the robot file that is named NAME or holds a ``package.xml``
+   whose ``<name>`` is NAME (the usual ``NAME/urdf/robot.urdf`` layout works with no setup);
+5. PyBullet's own rule, as a last resort: drop ``package://`` and look for the rest in the file's
+   folder and up to three folders above it. Many models (pybullet_data's panda, xarm) only load
+   because of this rule; :attr:`Resolution.via` says ``pybullet-search`` so the linter can warn
+   that ROS tools will not find those meshes. Relative paths get the same fallback.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+from urllib.parse import unquote
+
+_PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
+
+
+@dataclass(frozen=True)
+class Resolution:
+    """Where a URI points: ``path`` when found, else ``None`` with ``tried`` listing the candidates."""
+
+    uri: str
+    path: Path | None
+    tried: tuple[str, ...]
+    problem: str = ""
+    via: str = ""
+    """How it was found: ``direct``, ``package`` or ``pybullet-search`` (empty when not found)."""
+
+    @property
+    def found(self) -> bool:
+        return self.path is not None
+
+    def explain(self) -> str:
+        """One line for error messages: why the URI did not resolve and where we looked."""
+        if self.found:
+            return f"{self.uri} -> {self.path}"
+        reason = self.problem or "not found"
+        if self.tried:
+            return f"{self.uri}: {reason}; tried {', '.join(self.tried)}"
+        return f"{self.uri}: {reason}"
+
+
+def parse_package_paths(items: list[str] | None) -> dict[str, Path]:
+    """Turn repeated ``NAME=DIR`` options into a mapping; raises ValueError on a malformed item."""
+    mapping: dict[str, Path] = {}
+    for item in items or []:
+        name, sep, folder = item.partition("=")
+        if not sep or not name.strip() or not folder.strip():
+            raise ValueError(f"--package-path expects NAME=DIR, got {item!r}")
+        mapping[name.strip()] = Path(folder.strip()).expanduser()
+    return mapping
+
+
+@lru_cache(maxsize=256)
+def _package_xml_name(folder: Path) -> str | None:
+    manifest = folder / "package.xml"
+    try:
+        match = _PACKAGE_NAME.search(manifest.read_bytes()[:65536])
+    except OSError:
+        return None
+    return match.group(1).decode("utf-8", "replace") if match else None
+
+
+PYBULLET_SEARCH_LEVELS = 3
+"""How many folders above the robot file PyBullet's fallback search climbs (measured: differential/)."""
+
+
+class PackageResolver:
+    """Resolves URIs for one robot file; construct once per file and reuse (results are cached)."""
+
+    def __init__(
+        self,
+        base_dir: Path,
+        package_paths: Mapping[str, Path] | None = None,
+        environ: Mapping[str, str] | None = None,
+    ) -> None:
+        self.base_dir = base_dir.resolve()
+        self.package_paths = dict(package_paths or {})
+        env = os.environ if environ is None else environ
+        self._ros_paths = [Path(p) for p in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
+        self._ament_prefixes = [Path(p) for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
+        self._packages: dict[str, tuple[Path | None, tuple[str, ...]]] = {}
+
+    def find_package(self, name: str) -> tuple[Path | None, tuple[str, ...]]:
+        """Folder of package ``name`` and the candidates tried, following the module's order."""
+        if name not in self._packages:
+            self._packages[name] = self._search_package(name)
+        return self._packages[name]
+
+    def _search_package(self, name: str) -> tuple[Path | None, tuple[str, ...]]:
+        tried: list[str] = []
+
+        def accept(candidate: Path) -> bool:
+            tried.append(str(candidate))
+            return candidate.is_dir()
+
+        if name in self.package_paths and accept(self.package_paths[name]):
+            return self.package_paths[name], tuple(tried)
+        for entry in self._ros_paths:
+            if accept(entry / name):
+                return entry / name, tuple(tried)
+            if entry.name == name or _package_xml_name(entry) == name:
+                return entry, tuple(tried)
+        for prefix in self._ament_prefixes:
+            if accept(prefix / "share" / name):
+                return prefix / "share" / name, tuple(tried)
+        for ancestor in [self.base_dir, *self.base_dir.parents]:
+            if ancestor.name == name or _package_xml_name(ancestor) == name:
+                return ancestor, tuple(tried)
+            sibling = ancestor / name
+            if sibling.is_dir() and _package_xml_name(sibling) in (name, None) and (sibling / "package.xml").exists():
+                return sibling, tuple(tried)
+        tried.append(f"ancestors of {self.base_dir} named {name} or with package.xml <name>{name}</name>")
+        return None, tuple(tried)
+
+    def resolve(self, uri: str) -> Resolution:
+        """Resolve one URI as found in a ``filename`` attribute."""
+        uri = uri.strip()
+        if uri.startswith("package://"):
+            name, _, rest = uri[len("package://"):].partition("/")
+            if not name:
+                return Resolution(uri, None, (), "empty package name in package:/// URI")
+            folder, tried = self.find_package(name)
+            if folder is not None:
+                candidate = folder / unquote(rest)
+                tried = (*tried, str(candidate))
+                if candidate.is_file():
+                    return Resolution(uri, candidate, tried, via="package")
+            return self._pybullet_search(uri, unquote(uri[len("package://"):]), tried,
+                                         f"package '{name}' not found" if folder is None else "file not found in package")
+        if uri.startswith("file://"):
+            candidate = Path(unquote(uri[len("file://"):]))
+        elif "://" in uri:
+            return Resolution(uri, None, (), "unsupported URI scheme")
+        else:
+            candidate = Path(uri)
+        if not candidate.is_absolute():
+            candidate = self.base_dir / candidate
+        if candidate.is_file():
+            return Resolution(uri, candidate, (str(candidate),), via="direct")
+        if Path(uri).is_absolute() or uri.startswith("file://"):
+            return Resolution(uri, None, (str(candidate),), "file not found")
+        return self._pybullet_search(uri, uri, (str(candidate),), "file not found")
+
+    def _pybullet_search(self, uri: str, relative: str, tried: tuple[str, ...], problem: str) -> Resolution:
+        """PyBullet's fallback: ``relative`` inside the file's folder and a few folders above."""
+        folders = [self.base_dir, *list(self.base_dir.parents)[:PYBULLET_SEARCH_LEVELS]]
+        for folder in folders:
+            candidate = folder / relative
+            if str(candidate) not in tried:
+                tried = (*tried, str(candidate))
+            if candidate.is_file():
+                return Resolution(uri, candidate, tried, via="pybullet-search")
+        return Resolution(uri, None, tried, problem)

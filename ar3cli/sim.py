@@ -1,0 +1,303 @@
+"""The PyBullet session: the only module that talks to pybullet directly.
+
+Everything here follows measured behaviour (``shared/docs/pybullet-facts.md``), not tutorials:
+
+- pybullet is imported and used inside :func:`~ar3cli.capture.capture_fds`, so nothing it prints
+  from C reaches stdout; what it says is kept in :attr:`Session.messages`.
+- File caching is off by default (pybullet caches files by name for the whole session, so a URDF
+  rewritten by a fixer would otherwise load with its OLD content), and every load gets a fresh file
+  name besides. Caching off costs time when many models share meshes (measured: the 95 models of
+  pybullet_data load in 12.1 s uncached, 2.7 s cached), so bulk loaders may pass
+  ``file_caching=True``: the fresh names still guarantee the URDF itself is never stale.
+- Meshes are resolved by ar3cli (``package://`` included) and handed to pybullet as absolute
+  paths, in a temporary copy of the document: xacro files load the same way.
+- Joint types come from the URDF: pybullet reports continuous joints as revolute with the
+  limits (0, -1).
+- Link frames are ``getLinkState(...)[4:6]``, not ``[0:2]`` (that is the centre of mass), and the
+  base link frame is the base COM pose moved back by its local inertial frame.
+- A load failure quotes pybullet's real reason (the missing mesh), not "Cannot load URDF file".
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import math
+import tempfile
+from collections.abc import Iterable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ar3cli.capture import capture_fds
+from ar3cli.errors import UserError
+from ar3cli.model import Joint, Model
+
+Pose = tuple[tuple[float, float, float], tuple[float, float, float, float]]
+"""(position xyz, quaternion xyzw) in the world frame."""
+
+SELF_COLLISION_ALL_PAIRS = "all-pairs"
+_load_counter = itertools.count()
+
+
+def import_pybullet():
+    """Import pybullet with its build banner kept off the terminal; raises UserError if missing."""
+    with capture_fds():
+        try:
+            import pybullet
+        except ImportError as exc:
+            raise UserError(f"pybullet is not installed ({exc}); run: pip install pybullet") from None
+    return pybullet
+
+
+@dataclass(frozen=True)
+class JointRecord:
+    """One pybullet joint, with its type and limits as the URDF states them.
+
+    ``lower``/``upper`` are None for continuous joints and for joints PyBullet treats as
+    unlimited; :meth:`sample_range` is the range a sampler should draw from.
+    """
+
+    index: int
+    name: str
+    urdf_type: str
+    link_name: str
+    lower: float | None
+    upper: float | None
+    effort: float
+    velocity: float
+    urdf: Joint | None
+
+    @property
+    def movable(self) -> bool:
+        return self.urdf_type in ("revolute", "continuous", "prismatic")
+
+    @property
+    def continuous(self) -> bool:
+        return self.urdf_type == "continuous" or (self.urdf_type == "revolute" and self.lower is None)
+
+    def sample_range(self) -> tuple[float, float]:
+        """Where a uniform sampler should draw: [-pi, pi) for continuous or unlimited revolute joints."""
+        if self.lower is not None and self.upper is not None:
+            return self.lower, self.upper
+        if self.urdf_type == "prismatic":
+            return -1.0, 1.0
+        return -math.pi, math.pi
+
+    def home(self) -> float:
+        """0, or mid-range when 0 is outside the limits (MoveIt's convention)."""
+        lower, upper = self.sample_range()
+        return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
+
+
+class Body:
+    """A robot loaded in a :class:`Session`: its joints, links and frames."""
+
+    def __init__(self, session: Session, body_id: int, model: Model) -> None:
+        self.session = session
+        self.id = body_id
+        self.model = model
+        p = session.p
+        self.joints: list[JointRecord] = [self._record(p.getJointInfo(body_id, i, physicsClientId=session.client))
+                                          for i in range(p.getNumJoints(body_id, physicsClientId=session.client))]
+        self.base_name: str = p.getBodyInfo(body_id, physicsClientId=session.client)[0].decode("utf-8")
+        self.link_index: dict[str, int] = {self.base_name: -1}
+        self.link_index.update({joint.link_name: joint.index for joint in self.joints})
+
+    def _record(self, info: tuple) -> JointRecord:
+        name = info[1].decode("utf-8")
+        urdf = self.model.joint(name)
+        urdf_type = urdf.type if urdf is not None else _PYBULLET_TYPES.get(info[2], "unknown")
+        lower, upper = float(info[8]), float(info[9])
+        limited = lower <= upper and urdf_type != "continuous"
+        return JointRecord(
+            index=int(info[0]), name=name, urdf_type=urdf_type, link_name=info[12].decode("utf-8"),
+            lower=lower if limited else None, upper=upper if limited else None,
+            effort=float(info[10]), velocity=float(info[11]), urdf=urdf,
+        )
+
+    @property
+    def movable_joints(self) -> list[JointRecord]:
+        return [joint for joint in self.joints if joint.movable]
+
+    @property
+    def link_names(self) -> list[str]:
+        """Base first, then links in pybullet index order."""
+        return [self.base_name, *(joint.link_name for joint in self.joints)]
+
+    def set_positions(self, positions: Mapping[str, float] | Sequence[float]) -> None:
+        """Teleport joints (resetJointState); a sequence is in :attr:`movable_joints` order."""
+        p, client = self.session.p, self.session.client
+        if isinstance(positions, Mapping):
+            by_name = {joint.name: joint for joint in self.joints}
+            for name, value in positions.items():
+                p.resetJointState(self.id, by_name[name].index, float(value), physicsClientId=client)
+            return
+        joints = self.movable_joints
+        if len(positions) != len(joints):
+            raise ValueError(f"expected {len(joints)} joint positions, got {len(positions)}")
+        for joint, value in zip(joints, positions):
+            p.resetJointState(self.id, joint.index, float(value), physicsClientId=client)
+
+    def positions(self) -> list[float]:
+        """Current positions of :attr:`movable_joints`."""
+        p, client = self.session.p, self.session.client
+        states = p.getJointStates(self.id, [j.index for j in self.movable_joints], physicsClientId=client)
+        return [float(state[0]) for state in states]
+
+    def release_motors(self) -> None:
+        """Turn off the velocity motor pybullet attaches to every joint (target 0, max impulse 1)."""
+        p, client = self.session.p, self.session.client
+        indices = [joint.index for joint in self.movable_joints]
+        if indices:
+            p.setJointMotorControlArray(self.id, indices, p.VELOCITY_CONTROL, forces=[0.0] * len(indices),
+                                        physicsClientId=client)
+
+    def base_frame(self) -> Pose:
+        """The base *link frame*: pybullet's base pose is its COM, so undo the local inertial offset."""
+        p, client = self.session.p, self.session.client
+        com_position, com_orientation = p.getBasePositionAndOrientation(self.id, physicsClientId=client)
+        dynamics = p.getDynamicsInfo(self.id, -1, physicsClientId=client)
+        inverse_position, inverse_orientation = p.invertTransform(dynamics[3], dynamics[4])
+        position, orientation = p.multiplyTransforms(com_position, com_orientation,
+                                                     inverse_position, inverse_orientation)
+        return tuple(position), tuple(orientation)  # type: ignore[return-value]
+
+    def link_frames(self) -> dict[str, Pose]:
+        """World pose of every URDF link frame (``getLinkState(...)[4:6]``), base included."""
+        p, client = self.session.p, self.session.client
+        frames: dict[str, Pose] = {self.base_name: self.base_frame()}
+        indices = [joint.index for joint in self.joints]
+        if indices:
+            states = p.getLinkStates(self.id, indices, computeForwardKinematics=True, physicsClientId=client)
+            for joint, state in zip(self.joints, states):
+                frames[joint.link_name] = (tuple(state[4]), tuple(state[5]))  # type: ignore[assignment]
+        return frames
+
+    def contacts(self, distance: float = 0.0) -> list[tuple[str, str, float]]:
+        """Self-contacts after a fresh collision pass: (link_a, link_b, penetration depth in m)."""
+        p, client = self.session.p, self.session.client
+        p.performCollisionDetection(physicsClientId=client)
+        names = {index: name for name, index in self.link_index.items()}
+        seen: dict[tuple[str, str], float] = {}
+        points = (p.getClosestPoints(self.id, self.id, distance, physicsClientId=client) if distance > 0
+                  else p.getContactPoints(self.id, self.id, physicsClientId=client))
+        for point in points:
+            a, b = names[point[3]], names[point[4]]
+            if a == b:
+                continue
+            key = (a, b) if self.link_names.index(a) < self.link_names.index(b) else (b, a)
+            seen[key] = min(seen.get(key, math.inf), float(point[8]))
+        return [(a, b, depth) for (a, b), depth in sorted(seen.items())]
+
+
+_PYBULLET_TYPES = {0: "revolute", 1: "prismatic", 2: "spherical", 3: "planar", 4: "fixed"}
+
+
+class Session:
+    """One pybullet physics client (DIRECT by default); use as a context manager.
+
+    >>> with Session() as session:                                      # doctest: +SKIP
+    ...     body = session.load(load_model("assets/ar3/ar3.urdf"))
+    ...     frames = body.link_frames()
+    """
+
+    def __init__(self, gui: bool = False, gravity: float = 0.0, timestep: float = 1.0 / 240.0,
+                 file_caching: bool = False) -> None:
+        self.p = import_pybullet()
+        self.messages: list[str] = []
+        mode = self.p.GUI if gui else self.p.DIRECT
+        with capture_fds() as captured:
+            self.client = self.p.connect(mode)
+        self.messages.extend(captured.messages)
+        if self.client < 0:
+            raise UserError("pybullet could not connect (GUI needs a display; drop --gui)")
+        self._tmp = tempfile.TemporaryDirectory(prefix="ar3cli-")
+        self.p.setPhysicsEngineParameter(enableFileCaching=int(file_caching), physicsClientId=self.client)
+        self.p.setGravity(0, 0, gravity, physicsClientId=self.client)
+        self.p.setTimeStep(timestep, physicsClientId=self.client)
+
+    def __enter__(self) -> Session:
+        return self
+
+    def __exit__(self, *exc_info: Any) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Disconnect and remove temporary files; safe to call twice."""
+        if getattr(self, "client", -1) >= 0:
+            with capture_fds():
+                try:
+                    self.p.disconnect(physicsClientId=self.client)
+                except Exception:  # already gone (e.g. GUI window closed by the user)
+                    pass
+            self.client = -1
+        if hasattr(self, "_tmp"):
+            self._tmp.cleanup()
+
+    def load(
+        self,
+        model: Model,
+        fixed_base: bool = True,
+        flags: int | None = None,
+        base_position: Iterable[float] = (0.0, 0.0, 0.0),
+        base_orientation: Iterable[float] = (0.0, 0.0, 0.0, 1.0),
+        self_collision: str | None = None,
+    ) -> Body:
+        """Load ``model`` with explicit flags; raises UserError quoting pybullet's reason on failure.
+
+        Default flags: ``URDF_USE_INERTIA_FROM_FILE`` (pybullet's default recomputes every tensor
+        from the collision AABB) and ``URDF_MAINTAIN_LINK_ORDER``. ``self_collision="all-pairs"``
+        adds ``URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_INCLUDE_PARENT``.
+        """
+        p = self.p
+        if flags is None:
+            flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_MAINTAIN_LINK_ORDER
+        if self_collision == SELF_COLLISION_ALL_PAIRS:
+            flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_INCLUDE_PARENT
+        urdf_path = self._write_loadable_copy(model)
+        with capture_fds() as captured:
+            try:
+                body_id = p.loadURDF(str(urdf_path), list(base_position), list(base_orientation),
+                                     useFixedBase=fixed_base, flags=flags, physicsClientId=self.client)
+            except p.error:
+                body_id = -1
+        messages = [message.replace(str(urdf_path), str(model.path)) for message in captured.messages]
+        self.messages.extend(messages)
+        if body_id < 0:
+            raise UserError(f"{model.path}: pybullet cannot load it: {load_failure_reason(model, messages)}")
+        return Body(self, body_id, model)
+
+    def _write_loadable_copy(self, model: Model) -> Path:
+        """Write the (expanded) document with every mesh/texture filename made absolute."""
+        from lxml import etree
+
+        root = copy.deepcopy(model.root)
+        for element in root.iter():
+            uri = element.get("filename")
+            if not uri:
+                continue
+            resolution = model.resolver.resolve(uri)
+            if resolution.found:
+                element.set("filename", str(resolution.path))
+        path = Path(self._tmp.name) / f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
+        path.write_bytes(etree.tostring(root, xml_declaration=True, encoding="utf-8"))
+        return path
+
+    def step(self, count: int = 1) -> None:
+        for _ in range(count):
+            self.p.stepSimulation(physicsClientId=self.client)
+
+
+def load_failure_reason(model: Model, messages: list[str]) -> str:
+    """The most useful sentence about why pybullet refused a file."""
+    for _, shape in model.meshes():
+        resolution = shape.geometry.resolution
+        if resolution is not None and not resolution.found:
+            return f"mesh {resolution.explain()}"
+    interesting = [m for m in messages if not m.startswith("No inertial data")]
+    for keyword in ("cannot find", "invalid mesh", "does not specify limits", "Cannot", "cannot", "failed"):
+        for message in interesting:
+            if keyword in message:
+                return message
+    return interesting[0] if interesting else "pybullet gave no reason (Cannot load URDF file)"

@@ -1,0 +1,172 @@
+"""Read robot description bytes safely and tolerate the mess real files contain.
+
+Real URDF files are messy: 26 of pybullet_data's models declare ``<?xml version="0.0"?>``,
+CAD exporters leave blank lines before the declaration or NUL bytes after the root, Windows
+editors add a BOM and CRLF line endings. A strict parser refuses several of these; ar3cli loads
+them anyway and records each oddity as a :class:`Quirk`, so the linter can report it while every
+other command just works.
+
+What is never tolerated: entity declarations. libxml2 expands *internal* entities even with
+``resolve_entities=False`` (a "billion laughs" file still explodes), and URDF never needs them,
+so any ``<!ENTITY`` is refused before parsing. DTDs are not loaded and the network is never used.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from ar3cli.errors import UserError
+
+MAX_FILE_BYTES = 50 * 1024 * 1024
+"""Files larger than this are refused: no real URDF comes close (the largest in pybullet_data is ~1 MB)."""
+
+_DECLARATION = re.compile(rb"<\?xml[^>]*\?>")
+_VERSION_ATTR = re.compile(rb"""version\s*=\s*(["'])([^"']*)\1""")
+_ENCODING_ATTR = re.compile(rb"""encoding\s*=\s*(["'])([^"']*)\1""")
+_ENTITY_DECLARATION = re.compile(rb"<!ENTITY", re.IGNORECASE)
+_BOM = b"\xef\xbb\xbf"
+
+
+@dataclass(frozen=True)
+class Quirk:
+    """Something odd about a file that ar3cli worked around while loading it.
+
+    ``code`` is stable (``version-0.0``, ``leading-junk``, ``trailing-junk``, ``bom``, ``crlf``,
+    ``non-utf8-encoding``) so lint rules can map each quirk to a finding.
+    """
+
+    code: str
+    message: str
+    line: int = 1
+
+
+def read_bytes(path: Path) -> bytes:
+    """Return the file's bytes, or raise a one-line :class:`UserError` saying why not."""
+    if not path.exists():
+        raise UserError(f"{path}: no such file")
+    if path.is_dir():
+        raise UserError(f"{path}: is a directory, expected a .urdf or .xacro file")
+    size = path.stat().st_size
+    if size > MAX_FILE_BYTES:
+        raise UserError(
+            f"{path}: file is {size / 1e6:.0f} MB, larger than the {MAX_FILE_BYTES // 1024 // 1024} MB limit "
+            "for robot descriptions; is this really a URDF?"
+        )
+    try:
+        return path.read_bytes()
+    except OSError as exc:
+        raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+
+
+def refuse_entities(data: bytes, path: Path) -> None:
+    """Refuse entity declarations: they are the vector of entity bombs and external-file leaks."""
+    match = _ENTITY_DECLARATION.search(data)
+    if match:
+        line = data.count(b"\n", 0, match.start()) + 1
+        raise UserError(
+            f"{path}:{line}: declares an XML entity (<!ENTITY>); entities are refused because they "
+            "can expand without bound or read other files. Remove the DOCTYPE."
+        )
+
+
+def normalize(data: bytes) -> tuple[bytes, list[Quirk]]:
+    """Return bytes a strict XML parser accepts, with the line of every element unchanged.
+
+    Only the quirks listed in :class:`Quirk` are handled here; junk after the root element is
+    handled by :func:`parse` because only the parser knows where the root ends.
+    """
+    quirks: list[Quirk] = []
+    if data.startswith(_BOM):
+        quirks.append(Quirk("bom", "file starts with a UTF-8 byte order mark"))
+        data = data[len(_BOM):]
+    if b"\r\n" in data:
+        quirks.append(Quirk("crlf", "file uses CRLF (Windows) line endings"))
+    if b"\x00" in data:
+        # A NUL is never valid XML. CAD exporters pad files with them after the root; elsewhere
+        # the parser will still refuse the file with its own line number.
+        stripped = data.rstrip(b"\x00\r\n\t ")
+        if b"\x00" not in stripped:
+            quirks.append(Quirk("trailing-junk", "NUL bytes after the root element", stripped.count(b"\n") + 1))
+            data = stripped + b"\n"
+    declaration = _DECLARATION.search(data)
+    if declaration and declaration.start() > 0 and not data[: declaration.start()].strip():
+        # Blank lines before the declaration: swap them behind it so every later line keeps its number.
+        leading = data[: declaration.start()]
+        quirks.append(Quirk("leading-junk", "blank lines before the XML declaration", 1))
+        data = declaration.group(0) + leading + data[declaration.end():]
+        declaration = _DECLARATION.match(data)
+    if declaration and declaration.start() == 0:
+        text = declaration.group(0)
+        version = _VERSION_ATTR.search(text)
+        if version and version.group(2) != b"1.0":
+            quirks.append(
+                Quirk("version-" + version.group(2).decode("ascii", "replace"),
+                      f'XML declaration says version="{version.group(2).decode("ascii", "replace")}"; '
+                      'strict parsers only accept "1.0"')
+            )
+            fixed = text[: version.start(2)] + b"1.0" + text[version.end(2):]
+            data = fixed + data[declaration.end():]
+        encoding = _ENCODING_ATTR.search(text)
+        if encoding and encoding.group(2).lower().replace(b"_", b"-") not in (b"utf-8", b"utf8", b"ascii", b"us-ascii"):
+            quirks.append(Quirk("non-utf8-encoding",
+                                f"file is encoded as {encoding.group(2).decode('ascii', 'replace')}, not UTF-8"))
+    return data, quirks
+
+
+def parse(data: bytes, path: Path):
+    """Parse normalised bytes into an lxml element tree; errors become ``path:line: reason``.
+
+    Returns ``(root, quirks)``; quirks holds ``trailing-junk`` when content after the root
+    element had to be cut off.
+    """
+    from lxml import etree
+
+    parser = etree.XMLParser(
+        resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, remove_blank_text=False
+    )
+    quirks: list[Quirk] = []
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        cut = _end_of_root(data, exc)
+        if cut is None:
+            raise _syntax_error(path, exc) from None
+        quirks.append(Quirk("trailing-junk", "content after the root element", exc.lineno or 1))
+        try:
+            root = etree.fromstring(data[:cut], parser)
+        except etree.XMLSyntaxError as again:
+            raise _syntax_error(path, again) from None
+    except ValueError as exc:  # e.g. unknown encoding declared
+        raise UserError(f"{path}: cannot decode: {exc}") from None
+    return root, quirks
+
+
+def _end_of_root(data: bytes, exc) -> int | None:
+    """Byte offset where the root element ends, when the parser complained about extra content."""
+    if "Extra content at the end of the document" not in str(exc):
+        return None
+    lines = data.split(b"\n")
+    line, column = exc.position
+    if not 1 <= line <= len(lines):
+        return None
+    return sum(len(chunk) + 1 for chunk in lines[: line - 1]) + max(column - 1, 0)
+
+
+def _syntax_error(path: Path, exc) -> UserError:
+    line = exc.lineno or 0
+    message = str(exc.msg if hasattr(exc, "msg") else exc)
+    message = re.sub(r",? line \d+, column \d+.*$", "", message)
+    where = f"{path}:{line}" if line else str(path)
+    return UserError(f"{where}: not well-formed XML: {message}")
+
+
+def decode_text(data: bytes) -> str:
+    """Best-effort text of the file, for line-based checks (suppression comments, columns)."""
+    for encoding in ("utf-8", "latin-1"):
+        try:
+            return data.decode(encoding)
+        except UnicodeDecodeError:
+            continue
+    return data.decode("utf-8", "replace")  # pragma: no cover - latin-1 always decodes

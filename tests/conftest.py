@@ -1,0 +1,66 @@
+"""Shared test helpers: run the real CLI in a subprocess, find real models, write small fixtures."""
+
+from __future__ import annotations
+
+import os
+import subprocess
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+ASSETS = REPO / "assets"
+SHARED = REPO.parent / "shared"
+"""The steering repo's shared/ folder sits beside the clone in CI and in development."""
+
+
+@dataclass
+class CliResult:
+    code: int
+    stdout: str
+    stderr: str
+
+
+def run_cli(*args: str, cwd: Path | None = None, env: dict[str, str] | None = None,
+            timeout: float = 300) -> CliResult:
+    """Run ``python -m ar3cli ARGS`` in a fresh process, as a user would (C-level output included)."""
+    environment = {**os.environ, "PYTHONPATH": str(REPO), "NO_COLOR": "1", **(env or {})}
+    completed = subprocess.run([sys.executable, "-m", "ar3cli", *args], cwd=cwd or REPO, env=environment,
+                               capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
+    return CliResult(completed.returncode, completed.stdout, completed.stderr)
+
+
+@pytest.fixture
+def cli():
+    """The :func:`run_cli` helper as a fixture."""
+    return run_cli
+
+
+@pytest.fixture(scope="session")
+def pybullet_data_dir() -> Path:
+    import pybullet_data
+
+    return Path(pybullet_data.getDataPath())
+
+
+@pytest.fixture
+def shared_dir() -> Path:
+    """shared/ beside the clone; tests that need it skip cleanly where it is absent."""
+    if not SHARED.is_dir():
+        pytest.skip(f"shared/ folder not found at {SHARED} (it sits beside the clone in CI)")
+    return SHARED
+
+
+@pytest.fixture
+def write_urdf(tmp_path):
+    """Write a small URDF (text) into tmp_path and return its path."""
+
+    def write(text: str, name: str = "robot.urdf") -> Path:
+        path = tmp_path / name
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text, encoding="utf-8")
+        return path
+
+    return write
