@@ -1,0 +1,210 @@
+"""Rigid-body mass properties: the project's one place for inertia math.
+
+Conventions (the same as URDF ``<inertial>``):
+
+* SI units throughout: metres, kilograms, kg*m^2.
+* ``MassProperties.com`` is the centre of mass in the *reference frame* (usually the
+  link frame); ``MassProperties.inertia`` is the 3x3 inertia tensor **about the COM**,
+  with its axes parallel to that reference frame. This is exactly what a URDF
+  ``<inertial>`` with ``<origin rpy="0 0 0" xyz="com"/>`` expresses, so a result can be
+  written out without any further rotation.
+* Primitive shapes follow URDF geometry conventions: a box is centred on its origin, a
+  cylinder is centred on its origin with its axis along z, a sphere is centred.
+* ``rpy`` angles follow URDF: fixed-axis roll about x, then pitch about y, then yaw about
+  z, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
+
+The functions are pure numpy so that the linter can use them without importing pybullet
+or trimesh. Mesh-based mass properties belong in a separate function that returns the
+same ``MassProperties`` type.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+__all__ = [
+    "MassProperties",
+    "box",
+    "box_volume",
+    "combine",
+    "cylinder",
+    "cylinder_volume",
+    "is_positive_definite",
+    "principal_moments",
+    "rpy_to_matrix",
+    "scaled_to_mass",
+    "satisfies_triangle_inequality",
+    "sphere",
+    "sphere_volume",
+    "transformed",
+]
+
+
+@dataclass(frozen=True)
+class MassProperties:
+    """Mass, centre of mass and inertia tensor of a rigid body.
+
+    ``inertia`` is taken about ``com`` and expressed in the reference frame (see the
+    module docstring). Arrays are copied and made read-only so that the frozen
+    dataclass is really immutable.
+    """
+
+    mass: float
+    com: np.ndarray
+    inertia: np.ndarray
+
+    def __post_init__(self) -> None:
+        com = np.array(self.com, dtype=float).reshape(3)
+        inertia = np.array(self.inertia, dtype=float).reshape(3, 3)
+        com.setflags(write=False)
+        inertia.setflags(write=False)
+        object.__setattr__(self, "mass", float(self.mass))
+        object.__setattr__(self, "com", com)
+        object.__setattr__(self, "inertia", inertia)
+
+
+def _resolve_mass(volume: float, mass: float | None, density: float | None) -> float:
+    """Return the mass given either ``mass`` or ``density`` (exactly one of them).
+
+    Requiring exactly one avoids silently preferring one when a caller passes both.
+    """
+    if (mass is None) == (density is None):
+        raise ValueError("give exactly one of mass= or density=")
+    value = mass if mass is not None else density * volume  # type: ignore[operator]
+    if not value > 0.0:
+        raise ValueError(f"mass must be positive, got {value!r}")
+    return float(value)
+
+
+def _at_origin(mass: float, diagonal: Sequence[float]) -> MassProperties:
+    """Mass properties of a shape centred on the origin with a diagonal tensor."""
+    return MassProperties(mass, np.zeros(3), np.diag(np.asarray(diagonal, dtype=float)))
+
+
+def box_volume(size: ArrayLike) -> float:
+    """Volume of a box with edge lengths ``size`` = (x, y, z)."""
+    x, y, z = np.asarray(size, dtype=float).reshape(3)
+    return float(x * y * z)
+
+
+def cylinder_volume(radius: float, length: float) -> float:
+    """Volume of a solid cylinder."""
+    return math.pi * radius**2 * length
+
+
+def sphere_volume(radius: float) -> float:
+    """Volume of a solid sphere."""
+    return 4.0 / 3.0 * math.pi * radius**3
+
+
+def box(size: ArrayLike, mass: float | None = None, density: float | None = None) -> MassProperties:
+    """Solid box centred on the origin, edges along the axes (URDF ``<box size>``).
+
+    ``I_xx = m (y^2 + z^2) / 12`` and cyclic permutations.
+    """
+    x, y, z = np.asarray(size, dtype=float).reshape(3)
+    m = _resolve_mass(box_volume((x, y, z)), mass, density)
+    return _at_origin(m, (m * (y * y + z * z) / 12.0, m * (x * x + z * z) / 12.0, m * (x * x + y * y) / 12.0))
+
+
+def cylinder(
+    radius: float, length: float, mass: float | None = None, density: float | None = None
+) -> MassProperties:
+    """Solid cylinder centred on the origin, axis along z (URDF ``<cylinder>``).
+
+    ``I_xx = I_yy = m (3 r^2 + l^2) / 12``, ``I_zz = m r^2 / 2``.
+    """
+    m = _resolve_mass(cylinder_volume(radius, length), mass, density)
+    side = m * (3.0 * radius**2 + length**2) / 12.0
+    return _at_origin(m, (side, side, m * radius**2 / 2.0))
+
+
+def sphere(radius: float, mass: float | None = None, density: float | None = None) -> MassProperties:
+    """Solid sphere centred on the origin: ``I = 2 m r^2 / 5`` about every axis."""
+    m = _resolve_mass(sphere_volume(radius), mass, density)
+    moment = 2.0 * m * radius**2 / 5.0
+    return _at_origin(m, (moment, moment, moment))
+
+
+def rpy_to_matrix(rpy: ArrayLike) -> np.ndarray:
+    """Rotation matrix of URDF roll-pitch-yaw angles: ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``."""
+    roll, pitch, yaw = np.asarray(rpy, dtype=float).reshape(3)
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
+    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
+    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
+    return rz @ ry @ rx
+
+
+def transformed(mp: MassProperties, xyz: ArrayLike = (0.0, 0.0, 0.0), rpy: ArrayLike = (0.0, 0.0, 0.0)) -> MassProperties:
+    """Express ``mp`` in a parent frame in which its own frame sits at ``xyz``/``rpy``.
+
+    This is what a URDF ``<visual>``/``<collision>`` ``<origin>`` does to a shape: the
+    COM moves to ``xyz + R com`` and the tensor, still about the COM, is rotated to
+    ``R I R^T`` so that its axes are the parent's axes.
+    """
+    rot = rpy_to_matrix(rpy)
+    com = np.asarray(xyz, dtype=float).reshape(3) + rot @ mp.com
+    return MassProperties(mp.mass, com, rot @ mp.inertia @ rot.T)
+
+
+def combine(parts: Iterable[MassProperties]) -> MassProperties:
+    """Mass properties of several bodies rigidly joined, all in the same frame.
+
+    Total mass, mass-weighted COM, and each part's tensor moved to the common COM with
+    the parallel-axis theorem ``I + m (|d|^2 E - d d^T)``.
+    """
+    items = list(parts)
+    if not items:
+        raise ValueError("combine() needs at least one part")
+    total = sum(p.mass for p in items)
+    com = sum((p.mass * p.com for p in items), np.zeros(3)) / total
+    inertia = np.zeros((3, 3))
+    for p in items:
+        d = p.com - com
+        inertia += p.inertia + p.mass * (float(d @ d) * np.eye(3) - np.outer(d, d))
+    return MassProperties(total, com, inertia)
+
+
+def scaled_to_mass(mp: MassProperties, mass: float) -> MassProperties:
+    """Same shape and density distribution, different total mass.
+
+    COM is unchanged and the tensor scales linearly with mass. Used to give geometry a
+    known mass budget (for example a measured or CAD link mass).
+    """
+    if not mass > 0.0:
+        raise ValueError(f"mass must be positive, got {mass!r}")
+    return MassProperties(mass, mp.com, mp.inertia * (mass / mp.mass))
+
+
+def principal_moments(inertia: ArrayLike) -> np.ndarray:
+    """Eigenvalues of the (symmetrised) tensor, ascending.
+
+    They do not depend on the frame's orientation, which makes them the right thing to
+    compare and to check physical validity on.
+    """
+    tensor = np.asarray(inertia, dtype=float).reshape(3, 3)
+    return np.linalg.eigvalsh(0.5 * (tensor + tensor.T))
+
+
+def is_positive_definite(inertia: ArrayLike) -> bool:
+    """True when every principal moment is strictly positive (a physical body)."""
+    return bool(np.all(principal_moments(inertia) > 0.0))
+
+
+def satisfies_triangle_inequality(inertia: ArrayLike, tol: float = 1e-12) -> bool:
+    """True when each principal moment is at most the sum of the other two (+ ``tol``).
+
+    Every real mass distribution satisfies ``I_a + I_b >= I_c``; a tensor that violates
+    it cannot come from any body, and physics engines may become unstable with it.
+    ``tol`` absorbs rounding for thin shapes, where equality holds exactly.
+    """
+    a, b, c = principal_moments(inertia)
+    return bool(a + b + tol >= c and a + c + tol >= b and b + c + tol >= a)
