@@ -11,9 +11,7 @@ from __future__ import annotations
 
 import importlib.util
 import io
-import os
 import sys
-import tempfile
 from collections.abc import Iterator
 from pathlib import Path
 from types import ModuleType
@@ -24,16 +22,13 @@ import pytest
 from lxml import etree
 
 from ar3cli import mass_properties as mp
+from ar3cli.capture import capture_fds
+from tests.conftest import ASSETS, SHARED
 
-REPO = Path(__file__).resolve().parents[1]
-ASSETS = REPO / "assets"
 AR3 = ASSETS / "ar3" / "ar3.urdf"
 AR3_XACRO = ASSETS / "ar3" / "ar3.urdf.xacro"
 CUBE = ASSETS / "objects" / "cube.urdf"
 EXAMPLES = ASSETS / "examples"
-# The shared/ folder beside the repository clone; AR3CLI_SHARED_DIR overrides it (for git
-# worktrees, which live elsewhere).
-SHARED = Path(os.environ.get("AR3CLI_SHARED_DIR") or Path(__file__).resolve().parents[1].parent / "shared")
 REAL = SHARED / "models" / "ar3_description"
 
 ARM_JOINTS = [f"joint_{i}" for i in range(1, 7)]
@@ -82,21 +77,11 @@ def pb() -> Iterator[int]:
 
 
 def load(cid: int, path: Path, flags: int = 0) -> tuple[int, str]:
-    """Load a URDF with a fixed base and inertia from the file; return (body, C stdout text)."""
-    sys.stdout.flush()
-    saved = os.dup(1)
-    with tempfile.TemporaryFile() as sink:
-        os.dup2(sink.fileno(), 1)
-        try:
-            body = p.loadURDF(str(path), useFixedBase=True, physicsClientId=cid,
-                              flags=p.URDF_USE_INERTIA_FROM_FILE | flags)
-        finally:
-            sys.stdout.flush()
-            os.dup2(saved, 1)
-            os.close(saved)
-        sink.seek(0)
-        printed = sink.read().decode(errors="replace")
-    return body, printed
+    """Load a URDF with a fixed base and inertia from the file; return (body, C output text)."""
+    with capture_fds() as captured:
+        body = p.loadURDF(str(path), useFixedBase=True, physicsClientId=cid,
+                          flags=p.URDF_USE_INERTIA_FROM_FILE | flags)
+    return body, captured.text
 
 
 def joint_table(cid: int, body: int) -> dict[str, tuple]:
