@@ -31,8 +31,8 @@ def render_command(
 ) -> None:
     """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.
 
-    Links in contact with a link they are not joined to are drawn [red]red[/red]: the same problem
-    `lint-urdf --sim` reports. No display or GPU is needed.
+    Links in contact with a link they are not joined to are drawn [red]red[/red]: the problem `lint-urdf --sim` reports.
+    No display or GPU is needed.
     """
     from ar3cli.render import parse_configuration
     from ar3cli.render import render as draw
