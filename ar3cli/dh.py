@@ -314,7 +314,8 @@ def diagnose(table: DHTable, urdf_frames: Mapping[str, np.ndarray], q: np.ndarra
     if first_bad is not None and not any(d.kind in ("sign-flipped", "angles-in-degrees", "lengths-in-mm",
                                                     "angles-in-radians", "lengths-in-m") for d in diagnoses):
         diagnoses.extend(_fit_rows(table, urdf_frames, q, first_bad, tolerance_m, tolerance_rad))
-    if first_bad is not None:
+    explained = any(d.fix and d.kind != "wrong-value" for d in diagnoses)
+    if first_bad is not None and not explained:
         joint = table.raw_rows[first_bad - 1]["joint"]
         if table.convention == "standard":
             suspects = "the base_offset" if first_bad == 1 else f"row {first_bad - 1}'s d / a / alpha / theta_offset"
