@@ -60,7 +60,7 @@ class DHTable:
     def rows(self) -> list[DHRow]:
         length, angle = LENGTH_UNITS[self.length_unit], ANGLE_UNITS[self.angle_unit]
         return [DHRow(joint=str(raw["joint"]), a=raw["a"] * length, alpha=raw["alpha"] * angle, d=raw["d"] * length,
-                      theta_offset=raw["theta_offset"] * (length if joint.type == "prismatic" else angle),
+                      theta_offset=raw["theta_offset"] * angle,
                       sign=raw["sign"], prismatic=joint.type == "prismatic")
                 for raw, joint in zip(self.raw_rows, self.chain)]
 
@@ -295,14 +295,14 @@ def diagnose(table: DHTable, urdf_frames: Mapping[str, np.ndarray], q: np.ndarra
     tool_offset, base_offset = constant_offset(current, tolerance_m, tolerance_rad)
     if tool_offset is not None:
         new_tool = table.tool @ kinematics.invert(tool_offset)
-        xyz, rpy = kinematics.xyz_rpy(new_tool)
+        xyz, rpy = _tidy(kinematics.xyz_rpy(new_tool))
         diagnoses.append(Diagnosis("tool-offset", f"looks like a tool offset of {_fmt(xyz)} m (rpy {_fmt(rpy)} rad), "
                                    f"add it as tool: {{xyz: [{', '.join(f'{v:.9g}' for v in xyz)}], "
                                    f"rpy: [{', '.join(f'{v:.9g}' for v in rpy)}]}} (in m / rad)",
                                    {"tool": {"xyz": xyz, "rpy": rpy}}))
     elif base_offset is not None:
         new_base = kinematics.invert(base_offset) @ table.base_offset
-        xyz, rpy = kinematics.xyz_rpy(new_base)
+        xyz, rpy = _tidy(kinematics.xyz_rpy(new_base))
         diagnoses.append(Diagnosis("base-offset", f"looks like a base offset of {_fmt(xyz)} m (rpy {_fmt(rpy)} rad), "
                                    "set it as base_offset", {"base_offset": {"xyz": xyz, "rpy": rpy}}))
     for index, raw in enumerate(table.raw_rows):
@@ -330,6 +330,11 @@ def diagnose(table: DHTable, urdf_frames: Mapping[str, np.ndarray], q: np.ndarra
         diagnoses.append(Diagnosis("tool-or-last-row", "every DH frame moves rigidly with its URDF link, but the tip "
                                    "does not: check the last row and the tool", {}))
     return diagnoses
+
+
+def _tidy(pose: tuple[list[float], list[float]]) -> tuple[list[float], list[float]]:
+    """Round-off (below 1e-12) written as 0, so a suggested offset reads like what a person would type."""
+    return tuple([0.0 if abs(v) < 1e-12 else v for v in part] for part in pose)  # type: ignore[return-value]
 
 
 def _unit_diagnoses(table: DHTable, fixes) -> list[Diagnosis]:
