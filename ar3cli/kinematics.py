@@ -23,25 +23,15 @@ from dataclasses import dataclass
 import numpy as np
 
 from ar3cli.errors import UserError
+from ar3cli.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
 from ar3cli.model import Joint, Model
 
 REVOLUTE_TYPES = ("revolute", "continuous")
 SUPPORTED_TYPES = ("revolute", "continuous", "prismatic", "fixed")
 
 
-def rpy_matrix(rpy: Sequence[float]) -> np.ndarray:
-    """3x3 rotation of a URDF ``rpy``: ``Rz(yaw) @ Ry(pitch) @ Rx(roll)`` (fixed-axis X, Y, Z)."""
-    roll, pitch, yaw = rpy
-    cr, sr, cp, sp, cy, sy = np.cos(roll), np.sin(roll), np.cos(pitch), np.sin(pitch), np.cos(yaw), np.sin(yaw)
-    return np.array([
-        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
-        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
-        [-sp, cp * sr, cp * cr],
-    ])
-
-
 def matrix_rpy(rotation: np.ndarray) -> tuple[float, float, float]:
-    """Inverse of :func:`rpy_matrix` (pitch in [-pi/2, pi/2])."""
+    """Inverse of ``rpy_matrix`` (URDF rpy from a rotation; pitch in [-pi/2, pi/2])."""
     pitch = float(np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0])))
     roll = float(np.arctan2(rotation[2, 1], rotation[2, 2]))
     yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
