@@ -14,6 +14,7 @@ import typer
 from ar3cli import __version__
 from ar3cli.commands.install_check import install_check
 from ar3cli.commands.render import render_command
+from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.errors import EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -43,6 +44,7 @@ def _root(
 
 app.command("install-check")(install_check)
 app.command("render")(render_command)
+app.command("fk-verify")(fk_verify)
 
 
 def main(argv: list[str] | None = None) -> None:
