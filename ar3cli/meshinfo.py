@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import re
 import struct
+import warnings
 from functools import lru_cache
 from pathlib import Path
 
@@ -18,7 +19,7 @@ import numpy as np
 LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 MAX_MESH_BYTES = 200 * 1024 * 1024
 
-_OBJ_VERTEX = re.compile(rb"^[ \t]*v[ \t]+([^\r\n]+)", re.MULTILINE)
+_OBJ_VERTEX = re.compile(rb"^[ \t]*v[ \t]+(\S+[ \t]+\S+[ \t]+\S+)", re.MULTILINE)
 _STL_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
 
 
@@ -66,9 +67,15 @@ def _stl_vertices(data: bytes) -> np.ndarray | None:
 
 
 def _obj_vertices(data: bytes) -> np.ndarray | None:
-    rows = [line.split()[:3] for line in _OBJ_VERTEX.findall(data)]
-    rows = [row for row in rows if len(row) == 3]
-    return np.array(rows, dtype=float) if rows else None
+    rows = _OBJ_VERTEX.findall(data)
+    if not rows:
+        return None
+    with warnings.catch_warnings():  # np.fromstring(sep=) is the fastest text parser numpy has
+        warnings.simplefilter("ignore")
+        values = np.fromstring(b"\n".join(rows), sep=" ")
+    if values.size != 3 * len(rows):  # a token that is not a number: parse row by row
+        return np.array([row.split() for row in rows], dtype=float)
+    return values.reshape(-1, 3)
 
 
 def _trimesh_vertices(path: Path) -> np.ndarray | None:

@@ -217,8 +217,8 @@ def pybullet_only_path(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and resolution.found and resolution.via == "pybullet-search":
-            yield Hit(f"link '{link.name}' mesh {resolution.uri} found only by PyBullet's search, at "
-                      f"{resolution.path}", geometry.element)
+            yield Hit(f"link '{link.name}' mesh {resolution.uri} is found only by PyBullet's fallback search; "
+                      "ROS tools will not find it", geometry.element)
 
 
 RULES = (mesh_not_found, empty_package, absolute_path, mesh_format, lfs_pointer, mesh_units, scalar_scale,

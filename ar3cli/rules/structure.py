@@ -8,6 +8,8 @@ from collections.abc import Iterator
 from ar3cli.rules.base import Hit, arm, robot, rule
 
 JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+PYBULLET_JOINT_TYPES = ("spherical",)
+"""Joint types PyBullet accepts beyond the URDF spec (S010)."""
 
 
 @rule("S001", "robot-name", "error", "<robot> has no name",
@@ -188,10 +190,21 @@ def undefined_material(ctx) -> Iterator[Hit]:
       bad=arm(joint_type="hinge"), good=arm())
 def joint_type(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
-        if joint.type not in JOINT_TYPES:
+        if joint.type not in (*JOINT_TYPES, *PYBULLET_JOINT_TYPES):
             shown = f"'{joint.type}'" if joint.type else "missing"
             yield Hit(f"joint '{joint.name}' type is {shown}", joint.element)
 
 
+@rule("S010", "pybullet-joint-type", "warning", "Joint type only PyBullet understands",
+      why="""PyBullet accepts type="spherical" (a ball joint), but it is not part of URDF: urdfdom,
+      ROS, MoveIt and yourdfpy refuse the file.""",
+      fix="Keep the file PyBullet-only, or replace the ball joint by three revolute joints with massless links.",
+      bad=arm(joint_type="spherical"), good=arm())
+def pybullet_joint_type(ctx) -> Iterator[Hit]:
+    for joint in ctx.model.joints:
+        if joint.type in PYBULLET_JOINT_TYPES:
+            yield Hit(f"joint '{joint.name}' type '{joint.type}' is a PyBullet extension, not URDF", joint.element)
+
+
 RULES = (robot_name, duplicate_link, duplicate_joint, missing_link, several_roots, not_a_tree,
-         unknown_joint_reference, undefined_material, joint_type)
+         unknown_joint_reference, undefined_material, joint_type, pybullet_joint_type)
