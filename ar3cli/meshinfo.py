@@ -32,11 +32,20 @@ def is_lfs_pointer(path: Path) -> bool:
         return False
 
 
-@lru_cache(maxsize=1024)
 def mesh_bounds(path: Path) -> tuple[np.ndarray, np.ndarray] | None:
     """(min corner, max corner) of the mesh's vertices in file units, or None if unreadable/empty."""
     try:
-        if path.stat().st_size > MAX_MESH_BYTES or is_lfs_pointer(path):
+        stat = path.stat()
+    except OSError:
+        return None
+    return _mesh_bounds(path, stat.st_mtime_ns, stat.st_size)
+
+
+@lru_cache(maxsize=1024)
+def _mesh_bounds(path: Path, _mtime_ns: int, size: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """Cached by path, modification time and size, so a rewritten mesh is read again."""
+    try:
+        if size > MAX_MESH_BYTES or is_lfs_pointer(path):
             return None
         suffix = path.suffix.lower()
         if suffix == ".stl":
