@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 
-from ar3cli.rules.base import Hit, arm, rule
+from ar3cli.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 
 LIMITED_TYPES = ("revolute", "prismatic")
 ACTUATED_TYPES = ("revolute", "continuous", "prismatic")
@@ -159,5 +159,46 @@ def axis_not_unit(ctx) -> Iterator[Hit]:
                       hint=f'Use <axis xyz="{unit}"/>.')
 
 
+@rule("J011", "continuous-arm-joint", "warning", "Continuous joint without <limit> inside a chain",
+      why="""A continuous joint with no <limit> at all that carries further moving joints is the
+      signature of a CAD export: SolidWorks' sw_urdf_exporter writes every joint as continuous with
+      no limits unless told otherwise. Arm joints almost always have hard stops; planners then
+      wrap through them, and PyBullet reports effort 0 and velocity 0. Wheels and turntables at
+      the end of a chain, and continuous joints that state effort/velocity, are not flagged.""",
+      fix="Make it revolute with the real lower/upper/effort/velocity from the datasheet.",
+      bad=robot(f"""
+          <link name="base"/><link name="upper">{LINK_INERTIAL}</link><link name="fore">{LINK_INERTIAL}</link>
+          <joint name="shoulder" type="continuous"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/></joint>
+          <joint name="elbow" type="continuous"><parent link="upper"/><child link="fore"/><axis xyz="0 1 0"/></joint>"""),
+      good=robot(f"""
+          <link name="base"/><link name="upper">{LINK_INERTIAL}</link><link name="fore">{LINK_INERTIAL}</link>
+          <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
+            <limit lower="-2.9" upper="2.9" effort="20" velocity="1"/></joint>
+          <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><axis xyz="0 1 0"/>
+            <limit lower="-2" upper="2" effort="10" velocity="1"/></joint>"""))
+def continuous_arm_joint(ctx) -> Iterator[Hit]:
+    model = ctx.model
+    for joint in model.joints:
+        if joint.type != "continuous" or joint.limit is not None or not joint.child:
+            continue
+        downstream = _moving_descendants(model, joint.child)
+        if downstream:
+            yield Hit(f"continuous joint '{joint.name}' has no <limit> and carries {downstream} more moving joint"
+                      f"{'s' if downstream != 1 else ''}: an arm joint with no stops, effort 0 and velocity 0 "
+                      "in PyBullet", joint.element)
+
+
+def _moving_descendants(model, link_name: str) -> int:
+    """How many moving joints hang below ``link_name`` (cycles are S006's business: visited once)."""
+    count, stack, seen = 0, [link_name], {link_name}
+    while stack:
+        for child in model.child_joints(stack.pop()):
+            count += child.moves
+            if child.child and child.child not in seen:
+                seen.add(child.child)
+                stack.append(child.child)
+    return count
+
+
 RULES = (limit_missing, limit_range_missing, limit_inverted, limit_empty, limit_degrees, continuous_with_range,
-         effort_velocity_missing, effort_velocity_zero, axis_zero, axis_not_unit)
+         effort_velocity_missing, effort_velocity_zero, axis_zero, axis_not_unit, continuous_arm_joint)
