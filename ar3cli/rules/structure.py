@@ -163,10 +163,10 @@ def unknown_joint_reference(ctx) -> Iterator[Hit]:
                 yield Hit(f"transmission '{transmission.get('name', '?')}' names unknown joint '{name}'", element)
 
 
-@rule("S008", "undefined-material", "warning", "Material used but never defined",
+@rule("S008", "undefined-material", "info", "Material used but never defined",
       why="""A <material name="x"/> without <color> or <texture> refers to a top-level
-      <material name="x"> definition; when there is none, urdfdom refuses the file (it requires
-      a definition) and viewers show the default colour.""",
+      <material name="x"> definition. When there is none, check_urdf (urdfdom 3.0.1, measured) and
+      PyBullet load the file without a word and draw the default colour: the intended colour is lost.""",
       fix="Define <material name=\"x\"><color rgba=\"...\"/></material> at the top level, or add a <color>.",
       bad=robot('<link name="base"><visual><geometry><box size="1 1 1"/></geometry><material name="blue"/></visual></link>'),
       good=robot("""
