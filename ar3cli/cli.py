@@ -15,6 +15,7 @@ from ar3cli import __version__
 from ar3cli.commands.install_check import install_check
 from ar3cli.commands.render import render_command
 from ar3cli.commands.fk_verify import fk_verify
+from ar3cli.commands.lint_urdf import lint_urdf
 from ar3cli.errors import EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -45,6 +46,7 @@ def _root(
 app.command("install-check")(install_check)
 app.command("render")(render_command)
 app.command("fk-verify")(fk_verify)
+app.command("lint-urdf")(lint_urdf)
 
 
 def main(argv: list[str] | None = None) -> None:
