@@ -75,7 +75,7 @@ class GraspSettings:
     close_time: float = 0.6  # s for the fingers to close and squeeze
     ik_tolerance: float = 0.002  # m: a target further than this from the IK solution is unreachable
     success_rise: float = 0.05  # m the cube must end above its start
-    grasp_solver_iterations: int = 150  # pybullet's default 50 lets the squeezed cube creep and tilt
+    centring_span: float = 0.003  # m of finger asymmetry that shifts the whole squeeze to one finger
 
 
 @dataclass
@@ -248,6 +248,13 @@ class GraspScene:
             self.cube = self.session.load(cube_model, fixed_base=False, base_position=self.cube_start,
                                           base_orientation=p.getQuaternionFromEuler([0, 0, self.cube_yaw]))
             self.ik = IKSolver(arm_model)
+            # Friction anchors on the pads and the cube: without them pybullet's contact
+            # friction lets a squeezed box creep and tilt (measured: 5-18 deg and up to 1 cm of
+            # slip during a 1 s hold with the default 50 solver iterations). An anchor keeps
+            # the contact point fixed while it sticks; it is friction, not a constraint.
+            for link in (self.arm.link_index[name] for name in FINGER_LINKS):
+                p.changeDynamics(self.arm.id, link, frictionAnchor=1, physicsClientId=client)
+            p.changeDynamics(self.cube.id, -1, frictionAnchor=1, physicsClientId=client)
         except Exception:
             self.session.close()
             raise
@@ -264,6 +271,7 @@ class GraspScene:
         self.wall_start = time.perf_counter()
         self.target_q = np.zeros(len(ARM_JOINTS))
         self.finger_target = 0.0
+        self.squeezing = False
         self.command_fingers(0.0, self.finger_joints[0].effort)
 
     def close(self) -> None:
@@ -322,6 +330,25 @@ class GraspScene:
                                          force=force, maxVelocity=joint.velocity, positionGain=0.3,
                                          velocityGain=1.0, physicsClientId=self.client)
 
+    def centre_fingers(self) -> None:
+        """Share the squeeze between the fingers so the jaw stays centred on the tcp.
+
+        The two fingers are independent joints; both push with the same saturated force, so
+        the pair and the cube are in neutral balance and drift sideways together (measured:
+        6 mm in 3 s). A real parallel gripper couples its jaws mechanically. Here the total
+        force stays ``2 * gripper_force`` and moves towards the finger that is behind, each
+        finger's force within [0, effort]: a proportional coupling, not a constraint.
+        """
+        p, client = self.p, self.client
+        states = p.getJointStates(self.arm.id, [joint.index for joint in self.finger_joints], physicsClientId=client)
+        share = (states[0][0] - states[1][0]) / self.settings.centring_span
+        force = self.settings.gripper_force
+        for joint, sign in zip(self.finger_joints, (-1.0, 1.0)):
+            bounded = min(joint.effort, max(0.0, force * (1.0 + sign * share)))
+            p.setJointMotorControl2(self.arm.id, joint.index, p.POSITION_CONTROL, targetPosition=self.finger_target,
+                                    force=bounded, maxVelocity=joint.velocity, positionGain=0.3, velocityGain=1.0,
+                                    physicsClientId=client)
+
     def command_arm(self, q: Sequence[float], qdot: Sequence[float]) -> None:
         self.target_q = np.asarray(q, dtype=float)
         self.p.setJointMotorControlArray(self.arm.id, self.arm_indices, self.p.POSITION_CONTROL,
@@ -330,6 +357,8 @@ class GraspScene:
                                          velocityGains=[1.0] * len(q), physicsClientId=self.client)
 
     def step(self) -> None:
+        if self.squeezing:
+            self.centre_fingers()
         self.p.stepSimulation(physicsClientId=self.client)
         self.steps += 1
         if self.frame_hook is not None:
@@ -445,13 +474,9 @@ class GraspRun:
         scene.move_joints(path, times)
         self.check_tracking("descend", grasp, start)
 
-        # close: bounded force, target past the contact point so the pads squeeze. With the
-        # default 50 solver iterations the two force-saturated fingers and the cube creep
-        # sideways together and the cube tilts out (measured: 13 deg and 4 mm slip in 1 s of
-        # hold); 150 iterations hold it still. Set here: the free-space moves don't need them.
-        p.setPhysicsEngineParameter(numSolverIterations=settings.grasp_solver_iterations,
-                                    physicsClientId=scene.client)
+        # close: bounded force, target past the contact point so the pads squeeze
         scene.command_fingers(settings.squeeze_target, settings.gripper_force)
+        scene.squeezing = True
         scene.wait(settings.close_time)
         touching = scene.fingers_touching_cube()
         opening = scene.gripper_opening()
