@@ -12,6 +12,7 @@ import sys
 import typer
 
 from ar3cli import __version__
+from ar3cli.commands.grasp_demo import grasp_demo
 from ar3cli.commands.install_check import install_check
 from ar3cli.errors import EXIT_USAGE, UserError
 
@@ -41,6 +42,7 @@ def _root(
 
 
 app.command("install-check")(install_check)
+app.command("grasp-demo")(grasp_demo)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -418,13 +418,26 @@ class GraspScene:
         return waypoints, [distance / count / self.settings.cartesian_speed] * count
 
 
+def demo_camera(seed: int, settings: GraspSettings) -> dict[str, Any]:
+    """A fixed camera for the GIF: from the side of the arm's reach, looking at base and cube.
+
+    The arm moves in the vertical plane through the base and the cube, so the camera looks
+    across that plane (yaw = the cube's azimuth), from slightly above, at the point halfway
+    out at 28 cm height: base, cube and the 10 cm lift are all in view.
+    """
+    xy, _ = sample_cube_pose(seed, settings)
+    azimuth = math.degrees(math.atan2(xy[1], xy[0]))
+    return {"target": [0.5 * xy[0], 0.5 * xy[1], 0.28], "distance": 1.15, "yaw_deg": azimuth,
+            "pitch_deg": -18.0}
+
+
 def make_ground(p: Any, client: int) -> int:
-    """A static 2 m x 2 m slab whose top face is the z = 0 plane.
+    """A static 3 m x 3 m slab whose top face is the z = 0 plane.
 
     A box, not GEOM_PLANE: creating a plane body costs ~14 ms in DIRECT (its visual is built
     for the renderer), a box 0.2 ms; the demo's whole budget is ~0.3 s.
     """
-    half = [1.0, 1.0, 0.01]
+    half = [1.5, 1.5, 0.01]
     shape = p.createCollisionShape(p.GEOM_BOX, halfExtents=half, physicsClientId=client)
     visual = p.createVisualShape(p.GEOM_BOX, halfExtents=half, rgbaColor=[0.82, 0.84, 0.86, 1],
                                  physicsClientId=client)
@@ -511,7 +524,7 @@ class GraspRun:
         scene = self.scene
         rise = float(scene.cube_pose()[0][2] - scene.cube_start[2])
         if rise < scene.settings.success_rise:
-            self.record(name, target, False, f"cube slipped, ended {rise * 100:.1f} cm above its start "
+            self.record(name, target, False, f"cube slipped, ended {max(rise, 0.0) * 100:.1f} cm above its start "
                                              f"(needs {scene.settings.success_rise * 100:.0f} cm)")
         if not scene.cube_between_fingers():
             self.record(name, target, False, "cube is no longer between the fingers")
