@@ -248,8 +248,11 @@ class GraspScene:
             self.cube_half = cube_model.links[0].collisions[0].geometry.params["size"][2] / 2
             xy, self.cube_yaw = sample_cube_pose(seed, settings)
             self.cube_start = np.array([xy[0], xy[1], self.cube_half])
+            # a plain rigid body (maximal coordinates), not a one-link multibody: the grasp
+            # phases' contact steps are ~30% cheaper (measured 116 vs 168 us per step)
             self.cube = self.session.load(cube_model, fixed_base=False, base_position=self.cube_start,
-                                          base_orientation=p.getQuaternionFromEuler([0, 0, self.cube_yaw]))
+                                          base_orientation=p.getQuaternionFromEuler([0, 0, self.cube_yaw]),
+                                          maximal_coordinates=True)
             self.arm_model = arm_model
             # Friction anchors on the pads and the cube: without them pybullet's contact
             # friction lets a squeezed box creep and tilt (measured: 5-18 deg and up to 1 cm of
