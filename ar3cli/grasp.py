@@ -159,7 +159,7 @@ class IKSolver:
     """pybullet's calculateInverseKinematics on an IK-only copy of the arm.
 
     The copy is loaded into the given session (a second connection costs ~25 ms, a second
-    load ~10 ms) and must be :meth:`close`\ d (removed) before the simulation steps: it is
+    load ~10 ms) and must be removed with :meth:`close` before the simulation steps: it is
     reset to each iterate and solved again, which is never done to the simulated arm.
     """
 

@@ -74,7 +74,13 @@ class GifRecorder:
         return [10 * (round((i + 1) * frame_cs) - round(i * frame_cs)) for i in range(len(self.frames))]
 
     def write(self, path: Path) -> int:
-        """Write the GIF (to a temp file in the same folder, then rename); returns the frame count."""
+        """Write the GIF (to a temp file in the same folder, then rename); returns its frame count.
+
+        Pillow merges identical consecutive frames (adding up their durations), so the file
+        may hold fewer frames than were captured; the count returned is the file's.
+        """
+        from PIL import Image
+
         if not self.frames:
             raise UserError("nothing was recorded")
         path = Path(path)
@@ -87,8 +93,10 @@ class GifRecorder:
             first, *rest = [frame.quantize(palette=palette, dither=0) for frame in self.frames]
             first.save(temp, format="GIF", save_all=True, append_images=rest, duration=self.durations_ms(),
                        loop=0, optimize=False, disposal=1)
+            with Image.open(temp) as written:
+                count = written.n_frames
             os.replace(temp, path)
         except OSError as exc:
             Path(temp).unlink(missing_ok=True)
             raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
-        return len(self.frames)
+        return count
