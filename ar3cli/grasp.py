@@ -432,11 +432,11 @@ def demo_camera(seed: int, settings: GraspSettings) -> dict[str, Any]:
 
     The arm moves in the vertical plane through the base and the cube, so the camera looks
     across that plane (yaw = the cube's azimuth), from slightly above, at the point halfway
-    out at 28 cm height: base, cube and the 10 cm lift are all in view.
+    out at 32 cm height: base, cube and the 10 cm lift are all in view.
     """
     xy, _ = sample_cube_pose(seed, settings)
     azimuth = math.degrees(math.atan2(xy[1], xy[0]))
-    return {"target": [0.5 * xy[0], 0.5 * xy[1], 0.28], "distance": 1.15, "yaw_deg": azimuth,
+    return {"target": [0.5 * xy[0], 0.5 * xy[1], 0.32], "distance": 1.25, "yaw_deg": azimuth,
             "pitch_deg": -18.0}
 
 
