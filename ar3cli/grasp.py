@@ -377,7 +377,7 @@ class GraspScene:
         """Follow joint waypoints with linear interpolation (feed-forward velocity), then settle."""
         start = self.target_q
         for goal, duration in zip(waypoints, durations):
-            count = max(1, int(round(duration / TIMESTEP)))
+            count = max(1, round(duration / TIMESTEP))
             velocity = (goal - start) / (count * TIMESTEP)
             for i in range(1, count + 1):
                 self.command_arm(start + (goal - start) * (i / count), velocity)
@@ -387,7 +387,7 @@ class GraspScene:
         self.wait(self.settings.settle_time)
 
     def wait(self, duration: float) -> None:
-        for _ in range(int(round(duration / TIMESTEP))):
+        for _ in range(round(duration / TIMESTEP)):
             self.step()
 
     def joint_move_duration(self, start: np.ndarray, goal: np.ndarray) -> float:
@@ -420,7 +420,7 @@ class GraspScene:
         finer waypoints would only cost IK time.
         """
         distance = float(np.linalg.norm(goal - start))
-        count = max(1, int(math.ceil(distance / 0.02)))
+        count = max(1, math.ceil(distance / 0.02))
         waypoints, q = [], seed_q
         for i in range(1, count + 1):
             q = self.solve(ik, start + (goal - start) * (i / count), orientation, q, phase)

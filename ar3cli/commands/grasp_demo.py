@@ -77,7 +77,7 @@ def grasp_demo(
 
 def single_report(result: Any, data: dict[str, Any], extra_lines: list[str]) -> Report:
     """Phase table and verdict of one run."""
-    x, y, z = result.cube_start
+    x, y = result.cube_start[:2]
     rows = [[phase.name, phase.sim_time_s, phase.tcp_error_m * 1000, phase.gripper_opening_m * 1000,
              phase.cube_height_m * 100, "ok" if phase.ok else "fail", phase.detail] for phase in result.phases]
     table = Table(title=f"ar3cli grasp-demo (seed {result.seed}: cube at x={x:.3f} y={y:.3f} m, "
@@ -103,9 +103,10 @@ def trials_report(outcome: Any, ok: bool) -> Report:
                   columns=["seed", "result", "lift (cm)", "sim time (s)", "failed phase", "reason"],
                   rows=rows, status_column="result", numeric_columns=("seed", "lift (cm)", "sim time (s)"))
     data = outcome.to_dict()
-    lines = [f"{outcome.successes}/{len(outcome.runs)} succeeded ({outcome.success_rate:.0%}; target "
-             f"{TARGET_RATE:.0%}): {'ok' if ok else 'BELOW TARGET'}",
-             f"{data['sim_time_s']:.1f} s simulated in {data['wall_time_s']:.1f} s "
-             f"({data['realtime_factor']:.0f}x real time)"]
+    rate = (f"{outcome.successes}/{len(outcome.runs)} succeeded ({outcome.success_rate:.0%}; target "
+            f"{TARGET_RATE:.0%}): {'ok' if ok else 'BELOW TARGET'}")
+    timing = (f"{data['sim_time_s']:.1f} s simulated in {data['wall_time_s']:.1f} s "
+              f"({data['realtime_factor']:.0f}x real time)")
+    lines = [rate, timing]
     lines += [f"failed: seed {f['seed']} in {f['phase']}: {f['reason']}" for f in data["failures"]]
     return Report(data=data, tables=[table], lines=lines, ok=ok)
