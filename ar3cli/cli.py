@@ -12,6 +12,7 @@ import sys
 import typer
 
 from ar3cli import __version__
+from ar3cli.commands.grasp_demo import grasp_demo
 from ar3cli.commands.install_check import install_check
 from ar3cli.commands.render import render_command
 from ar3cli.commands.fk_verify import fk_verify
@@ -47,6 +48,7 @@ app.command("install-check")(install_check)
 app.command("render")(render_command)
 app.command("fk-verify")(fk_verify)
 app.command("lint-urdf")(lint_urdf)
+app.command("grasp-demo")(grasp_demo)
 
 
 def main(argv: list[str] | None = None) -> None:
