@@ -28,6 +28,8 @@ def annotation(finding: Finding) -> str:
 
 
 def markdown_cell(text: str) -> str:
+    """Text safe inside a table cell: pipes escaped, and ``<inertial>`` shown, not eaten as an HTML tag."""
+    text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
     return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
 
 

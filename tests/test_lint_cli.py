@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from ar3cli.rules.base import arm
-from tests.conftest import SHARED
+from tests.conftest import ASSETS, SHARED
 
 ZERO_EFFORT = arm(joint_extra='<limit lower="-1" upper="1" effort="0" velocity="1"/>')  # J008 warning
 NO_LIMIT = arm(joint_extra="")  # J001 error
@@ -78,6 +78,19 @@ def test_markdown_table(cli, write_urdf):
     result = cli("lint-urdf", str(write_urdf(NO_LIMIT)), "--format", "markdown")
     assert "| location | rule | severity | message | hint |" in result.stdout
     assert "| J001 | error |" in result.stdout
+
+
+def test_github_format_writes_step_summary(cli, tmp_path):
+    summary = tmp_path / "step_summary.md"
+    summary.write_text("earlier step\n")
+    example = str(ASSETS / "examples" / "ar3_no_inertia.urdf")
+    result = cli("lint-urdf", example, "--format", "github", env={"GITHUB_STEP_SUMMARY": str(summary)})
+    assert result.code == 1
+    assert result.stdout.startswith("::error file=")
+    text = summary.read_text()
+    assert text.startswith("earlier step\n## ar3cli lint-urdf")  # appended, as GitHub expects
+    assert "| I001 | error |" in text
+    assert "&lt;inertial&gt;" in text and "<inertial>" not in text  # not swallowed as an HTML tag
 
 
 def test_select_and_ignore(cli, write_urdf):

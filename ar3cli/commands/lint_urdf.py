@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import enum
+import os
 import sys
 from pathlib import Path
 from typing import Annotated, Optional
@@ -42,13 +43,13 @@ def lint_urdf(
                                                         help="Skip these rule codes or prefixes (added to the "
                                                              "config's ignore).")] = None,
     fail_on: Annotated[Optional[FailOn], typer.Option("--fail-on", help="Exit 1 when a finding is at least this "
-                                                                        "severe [default: error].",
+                                                                        "severe (default: error, or the config's fail-on).",
                                                       show_default=False)] = None,
     exit_zero: Annotated[bool, typer.Option("--exit-zero", help="Exit 0 even when there are findings.")] = False,
     sim: Annotated[bool, typer.Option("--sim", help="Also load each model in PyBullet (P rules): load errors, "
                                                     "self-collision at home, inertia PyBullet really uses, stability.")]
     = False,
-    no_config: Annotated[bool, typer.Option("--no-config", help="Ignore [tool.ar3cli.lint] in pyproject.toml.")]
+    no_config: Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
     = False,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
@@ -106,11 +107,15 @@ def render_lint(results, summary: dict, options, fmt: LintFormat) -> None:
 
         emit_json(sarif_document(findings, options.rules()))
     elif fmt is LintFormat.github:
-        from ar3cli.output_github import annotation
+        from ar3cli.output_github import annotation, markdown_table
 
         for finding in findings:
             print(annotation(finding))
         print(summary_line(summary))
+        step_summary = os.environ.get("GITHUB_STEP_SUMMARY")
+        if step_summary:  # GitHub Actions: the reviewer sees the table on the run's summary page
+            with open(step_summary, "a", encoding="utf-8") as handle:
+                handle.write(markdown_table(findings, summary_line(summary)))
     elif fmt is LintFormat.markdown:
         from ar3cli.output_github import markdown_table
 
