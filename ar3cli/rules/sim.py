@@ -104,10 +104,15 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
                           'izz="0.001768"/></inertial><collision><geometry><box size="0.1 0.1 1"/></geometry></collision>'),
       needs_sim=True)
 def sim_inertia_differs(ctx) -> Iterator[Hit]:
+    """One finding per file: how many links PyBullet's default load changes, pointing at the worst one.
+
+    A per-link finding would bury a clean model in rows: the default load replaces *every* tensor.
+    """
     from ar3cli.rules.inertia import _finite, _moments
 
     session = ctx.session
     p = session.p
+    changed: list[tuple[float, str, object]] = []  # (relative difference, description, element)
     with _loaded(ctx, fixed_base=False, flags=p.URDF_MAINTAIN_LINK_ORDER) as body:
         if body is None:
             return
@@ -126,12 +131,22 @@ def sim_inertia_differs(ctx) -> Iterator[Hit]:
                 parts.append("principal moments " + "(" + ", ".join(f"{m:.3g}" for m in file_moments) + ") in the file, "
                              + "(" + ", ".join(f"{m:.3g}" for m in used) + ") used by PyBullet's default load")
             if parts:
-                yield Hit(f"link '{link.name}': " + "; ".join(parts), inertial.element)
+                worst = max(_relative(u, f) for u, f in zip([used_mass, *used], [inertial.mass, *file_moments]))
+                changed.append((worst, f"link '{link.name}': " + "; ".join(parts), inertial.element))
+    if changed:
+        worst, description, element = max(changed, key=lambda item: item[0])
+        others = len(changed) - 1
+        more = f" and {others} other link{'s' if others != 1 else ''}" if others else ""
+        yield Hit(f"{description}{more} (largest difference {worst:.0%})", element)
+
+
+def _relative(used: float, declared: float) -> float:
+    scale = max(abs(used), abs(declared))
+    return abs(used - declared) / scale if scale > 0 else 0.0
 
 
 def _differs(used: float, declared: float) -> bool:
-    scale = max(abs(used), abs(declared))
-    return scale > 0 and abs(used - declared) > INERTIA_TOLERANCE * scale
+    return _relative(used, declared) > INERTIA_TOLERANCE
 
 
 @rule("P004", "sim-unstable", "error", "NaN or exploding states after settling under gravity",
