@@ -31,7 +31,7 @@ def render_command(
 ) -> None:
     """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.
 
-    Links in contact with a link they are not joined to are drawn [red]red[/red]: the problem `lint-urdf --sim` reports.
+    Links in contact with a link they are not joined to are drawn red: the problem `lint-urdf --sim` reports.
     No display or GPU is needed.
     """
     from ar3cli.render import parse_configuration
