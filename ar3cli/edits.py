@@ -84,20 +84,22 @@ class Document:
         self.indent_unit = _indent_unit(data, self.spans)
 
     # ---- mapping lxml elements to spans ----------------------------------------------------
-    def bind(self, root) -> dict[int, Span]:
-        """Map ``id(element)`` of every lxml element under ``root`` to its span.
+    def bind(self, root) -> dict[str, Span]:
+        """Map the path (``/robot/link[3]/inertial``) of every lxml element under ``root`` to its span.
 
+        Paths, not ``id()``: lxml creates a new Python proxy each time an element is looked up.
         Raises when the scan and the parse disagree (then no edit is safe).
         """
         elements = [e for e in root.iter() if isinstance(e.tag, str)]
         if len(elements) != len(self.spans) or any(e.tag != s.tag for e, s in zip(elements, self.spans)):
             raise UserError("cannot map the file's elements to byte positions safely; refusing to edit it")
-        self._by_id = {id(e): s for e, s in zip(elements, self.spans)}
-        return self._by_id
+        self._tree = root.getroottree()
+        self._by_path = {self._tree.getpath(e): s for e, s in zip(elements, self.spans)}
+        return self._by_path
 
     def span(self, element) -> Span:
         """The span of an lxml element (after :meth:`bind`)."""
-        return self._by_id[id(element)]
+        return self._by_path[self._tree.getpath(element)]
 
     # ---- text helpers ------------------------------------------------------------------------
     def indentation(self, span: Span) -> bytes:
@@ -141,16 +143,31 @@ class Document:
         if attribute is not None:
             self.splice(attribute.start, attribute.end, b"")
 
-    def insert_child(self, parent: Span, lines: list[str], after: Span | None = None) -> None:
+    def insert_child(self, parent: Span, lines: list[str], after: Span | None = None,
+                     before: Span | None = None) -> None:
         """Insert a new child element given as text lines (relative indentation in units of 2 spaces).
 
-        It goes after ``after`` (default: the parent's last child) on a new line with the
-        siblings' indentation and the file's line ending. A self-closing parent is expanded.
+        It goes after ``after`` (default: the parent's last child) or before ``before``, on its own
+        line with the siblings' indentation and the file's line ending. When the siblings share
+        one line (``<inertial><mass/><inertia/></inertial>``) a one-line child joins them with a
+        space. A self-closing parent is expanded.
         """
         indent = self.child_indentation(parent)
+        anchor = before or after or (parent.children[-1] if parent.children else None)
+        inline = anchor is not None and len(lines) == 1 and b"\n" not in self.data[parent.start:anchor.end]
+        if inline:
+            text = self._relative_indent(lines[0])
+            if before is not None:
+                self.splice(before.start, before.start, text + b" ")
+            else:
+                self.splice(anchor.end, anchor.end, b" " + text)
+            return
         body = self.newline.join(indent + self._relative_indent(line) for line in lines)
-        anchor = after or (parent.children[-1] if parent.children else None)
-        if anchor is not None:
+        if before is not None:
+            own_indent = self.indentation(before)
+            start = before.start - len(own_indent)
+            self.splice(start, start, body + self.newline)
+        elif anchor is not None:
             self.splice(anchor.end, anchor.end, self.newline + body)
         elif parent.self_closing:
             close = self.newline + self.indentation(parent) + f"</{parent.tag}>".encode()
