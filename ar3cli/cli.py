@@ -14,6 +14,7 @@ import typer
 from ar3cli import __version__
 from ar3cli.commands.install_check import install_check
 from ar3cli.commands.fix_inertia import fix_inertia
+from ar3cli.commands.fix_continuous import fix_continuous
 from ar3cli.errors import EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -43,6 +44,7 @@ def _root(
 
 app.command("install-check")(install_check)
 app.command("fix-inertia")(fix_inertia)
+app.command("fix-continuous")(fix_continuous)
 
 
 def main(argv: list[str] | None = None) -> None:
