@@ -120,22 +120,44 @@ def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float]) -> tuple[
         raise GeometryError(f"mesh {path.name}: cannot read: {exc}") from None
     if mesh is None or len(getattr(mesh, "faces", ())) == 0:
         raise GeometryError(f"mesh {path.name} has no triangles")
+    # OBJ files split vertices by texture coordinate / normal: weld them by position only.
+    mesh.merge_vertices(merge_tex=True, merge_norm=True)
     if tuple(scale) != (1.0, 1.0, 1.0):
         mesh.apply_transform(np.diag([*scale, 1.0]))
     scale_note = "" if tuple(scale) == (1.0, 1.0, 1.0) else f" scale {' '.join(_fmt(s) for s in scale)}"
-    if mesh.is_watertight:
+    watertight = mesh.is_watertight
+    if watertight or is_closed(mesh):
         if mesh.volume < 0:
             mesh.invert()
         if not mesh.volume > 0:
             raise GeometryError(f"mesh {path.name} encloses no volume")
         props = _trimesh_props(mesh)
-        return props, f"mesh {path.name}{scale_note} watertight, exact"
+        kind = "watertight" if watertight else "closed (some edges shared by more than 2 faces)"
+        return props, f"mesh {path.name}{scale_note} {kind}, exact"
     hull = mesh.convex_hull
     mesh_volume = abs(float(mesh.volume))
     ratio = hull.volume / mesh_volume if mesh_volume > 0 else float("inf")
     props = _trimesh_props(hull)
     return props, (f"mesh {path.name}{scale_note} not watertight: convex hull, hull/mesh volume "
                    f"{ratio:.3g} (mesh volume of an open mesh is approximate)")
+
+
+def is_closed(mesh) -> bool:
+    """True when every directed edge a->b is matched by as many b->a: the surface bounds a volume.
+
+    That is exactly what the divergence theorem behind the signed-tetrahedra volume needs. It
+    is weaker than trimesh's ``is_watertight`` (every edge in exactly two faces): CAD exports
+    such as the AR3 STLs have edges shared by four faces where two solids touch, and are
+    still closed, so their volume integral is exact (it equals their CAD mass at 1000 kg/m^3).
+    """
+    edges = np.asarray(mesh.edges)
+    if len(edges) == 0:
+        return False
+    forward = edges[:, 0] < edges[:, 1]
+    key = np.where(forward[:, None], edges, edges[:, ::-1])
+    sign = np.where(forward, 1, -1)
+    _, inverse = np.unique(key, axis=0, return_inverse=True)
+    return bool(np.all(np.bincount(inverse.reshape(-1), weights=sign) == 0))
 
 
 def _trimesh_props(mesh) -> mp.MassProperties:
