@@ -225,6 +225,8 @@ def inertia_problem(model: Model, link: Link, moving: set[str], cache: dict | No
     if inertial.mass is None or not math.isfinite(inertial.mass):
         return "mass missing or malformed"
     if inertial.mass <= 0:
+        if inertial.mass == 0 and link.name not in moving and model.parent_joint(link.name) is None:
+            return None  # a massless root is the usual way to say "static base" (pybullet honours it)
         return f"mass {inertial.mass:g} <= 0"
     if inertial.tensor is None or not all(map(math.isfinite, inertial.tensor)):
         return "inertia tensor missing or malformed"
