@@ -169,6 +169,9 @@ def _report(command: str, results: list[FileResult], *, diff: bool, check: bool,
     if verify_rows:
         tables.append(Table("verified in PyBullet", ["file", "joint", "check", "status", "detail"], verify_rows,
                             status_column="status"))
+    if len(results) == 1:  # the file is in the summary line; keep the table narrow
+        for table in tables:
+            table.columns, table.rows = table.columns[1:], [row[1:] for row in table.rows]
     lines = [note for r in results for note in r.plan.notes]
     for r in results:
         if not r.changed:
