@@ -12,8 +12,8 @@ from ar3cli.output import OutputFormat, Report, Table, render
 def install_check(format: FormatOption = OutputFormat.text) -> None:
     """Check that Python, PyBullet and ar3cli's libraries are installed and behave.
 
-    Each check prints ok / warn / fail / info, a detail, and for problems the exact command to
-    run. Exit code 1 when any check fails.
+    Each check prints ok / warn / fail / info, a detail, and for problems the exact command to run.
+    Exit code 1 when any check fails.
     """
     from ar3cli.doctor import run_checks
 

@@ -1,0 +1,50 @@
+"""``ar3cli render``: a picture of the model, offscreen."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.errors import EXIT_OK
+from ar3cli.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, load_from_options
+from ar3cli.output import OutputFormat, Report, Table, render
+
+
+def render_command(
+    path: RobotPathArgument,
+    output: Annotated[Path, typer.Option("--output", "-o", help="PNG file to write.")] = Path("robot.png"),
+    config: Annotated[Optional[str], typer.Option(
+        "--config", metavar="JOINT=VALUE,...",
+        help="Joint values in rad (or m); joints not named stay at home (0, or mid-range when 0 is outside "
+             "the limits).")] = None,
+    collision: Annotated[bool, typer.Option("--collision", help="Draw the collision geometry (blue) instead of the visual geometry.")]
+    = False,
+    width: Annotated[int, typer.Option(help="Image width in pixels.")] = 800,
+    height: Annotated[int, typer.Option(help="Image height in pixels.")] = 600,
+    yaw: Annotated[float, typer.Option(help="Camera yaw around the robot, degrees.")] = 45.0,
+    pitch: Annotated[float, typer.Option(help="Camera pitch, degrees (negative looks down).")] = -20.0,
+    package_path: PackagePathOption = None,
+    xacro_arg: XacroArgOption = None,
+    format: FormatOption = OutputFormat.text,
+) -> None:
+    """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.
+
+    Links in contact with a link they are not joined to are drawn [red]red[/red]: the problem `lint-urdf --sim` reports.
+    No display or GPU is needed.
+    """
+    from ar3cli.render import parse_configuration
+    from ar3cli.render import render as draw
+
+    configuration = parse_configuration(config)
+    model = load_from_options(path, package_path, xacro_arg)
+    result = draw(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
+                  show_collision=collision)
+    tables = []
+    if result.contacts:
+        tables.append(Table(title="links in contact (drawn red)", columns=["link a", "link b", "depth (m)"],
+                            rows=[[a, b, d] for a, b, d in result.contacts], numeric_columns=("depth (m)",)))
+    lines = [f"wrote {result.path} ({result.width}x{result.height})"]
+    render(Report(data=result.to_dict(), tables=tables, lines=lines), format)
+    raise typer.Exit(EXIT_OK)

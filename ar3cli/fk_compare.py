@@ -1,0 +1,161 @@
+"""PyBullet's link frames against the independent URDF forward kinematics.
+
+The configurations are set in PyBullet (``resetJointState``) and the *link frames* are read
+(``getLinkState(...)[4:6]``, via :meth:`ar3cli.sim.Body.link_frames`), then the same frames are
+computed by :func:`ar3cli.kinematics.urdf_link_frames` from the Model. Differences that real
+models produce are explained by :func:`model_notes`: mimic joints (pybullet does not couple them, so
+we set the mimic joint's value ourselves), non-unit axes (pybullet normalises revolute axes but
+moves prismatic joints by ``|axis| * q``), and the base pose being the COM in pybullet.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ar3cli import kinematics
+from ar3cli.model import Model
+
+
+@dataclass
+class Samples:
+    """N configurations: ``values[:, i]`` drives ``names[i]``; ``all_values`` adds the mimic joints."""
+
+    seed: int
+    names: list[str]
+    values: np.ndarray
+    all_values: dict[str, np.ndarray]
+
+    @property
+    def count(self) -> int:
+        return int(self.values.shape[0])
+
+    def configuration(self, index: int) -> dict[str, float]:
+        """One sample as {joint: value} (driving joints only), for reports."""
+        return {name: float(self.values[index, i]) for i, name in enumerate(self.names)}
+
+
+@dataclass
+class LinkError:
+    """Errors of one link frame over all samples."""
+
+    link: str
+    max_position: float
+    mean_position: float
+    max_orientation: float
+    mean_orientation: float
+    worst_sample: int
+
+    def to_dict(self) -> dict:
+        return {"link": self.link, "max_position_error_m": self.max_position,
+                "mean_position_error_m": self.mean_position, "max_orientation_error_rad": self.max_orientation,
+                "mean_orientation_error_rad": self.mean_orientation, "worst_sample": self.worst_sample}
+
+
+@dataclass
+class Comparison:
+    """Per-link errors, the explaining notes, and the independent frames (reused by the DH check)."""
+
+    links: list[LinkError]
+    notes: list[str] = field(default_factory=list)
+    reference: dict[str, np.ndarray] = field(default_factory=dict)
+
+
+def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
+    """Uniform samples within each driving joint's range (continuous: [-pi, pi)); mimic joints follow.
+
+    Ranges come from :meth:`ar3cli.sim.JointRecord.sample_range`, i.e. the URDF's limits.
+    """
+    rng = np.random.default_rng(seed)
+    driving = [joint for joint in body.movable_joints if joint.urdf is None or joint.urdf.mimic is None
+               or model.joint(joint.urdf.mimic.joint) is None]
+    ranges = np.array([joint.sample_range() for joint in driving]).reshape(-1, 2)
+    values = rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, len(driving)))
+    names = [joint.name for joint in driving]
+    all_values = kinematics.driven_values(model, {n: values[:, i] for i, n in enumerate(names)}, count)
+    return Samples(seed=seed, names=names, values=values, all_values=all_values)
+
+
+def pybullet_frames(body, samples: Samples, com: bool = False) -> dict[str, np.ndarray]:
+    """(N, 4, 4) world frames per link from pybullet, every joint (mimic ones too) set explicitly.
+
+    ``com=True`` reads the centre-of-mass frames instead (``getLinkState(...)[0:2]`` and the raw base
+    pose): the tutorial mistake, kept so tests can show what it costs.
+    """
+    p, client = body.session.p, body.session.client
+    names = [joint.name for joint in body.movable_joints]
+    indices = [joint.index for joint in body.joints]
+    links = body.link_names
+    positions = np.zeros((samples.count, len(links), 3))
+    quaternions = np.zeros((samples.count, len(links), 4))
+    columns = np.stack([samples.all_values[name] for name in names], axis=1) if names else np.zeros((samples.count, 0))
+    for n in range(samples.count):
+        body.set_positions(columns[n])
+        if com:
+            base = p.getBasePositionAndOrientation(body.id, physicsClientId=client)
+            states = p.getLinkStates(body.id, indices, computeForwardKinematics=True,
+                                     physicsClientId=client) if indices else []
+            poses = [base, *((state[0], state[1]) for state in states)]
+        else:
+            frames = body.link_frames()
+            poses = [frames[link] for link in links]
+        for i, (position, orientation) in enumerate(poses):
+            positions[n, i] = position
+            quaternions[n, i] = orientation
+    result = {}
+    for i, link in enumerate(links):
+        frames = np.tile(np.eye(4), (samples.count, 1, 1))
+        frames[:, :3, :3] = kinematics.quaternion_matrices(quaternions[:, i])
+        frames[:, :3, 3] = positions[:, i]
+        result[link] = frames
+    return result
+
+
+def compare_links(reference: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> list[LinkError]:
+    """Per-link max/mean errors for links present in both, in ``measured`` order."""
+    errors = []
+    for link, frames in measured.items():
+        if link not in reference:
+            continue
+        position, angle = kinematics.pose_errors(reference[link], frames)
+        worst = int(np.argmax(position / max(float(position.max()), 1e-300)
+                              + angle / max(float(angle.max()), 1e-300)))
+        errors.append(LinkError(link, float(position.max()), float(position.mean()), float(angle.max()),
+                                float(angle.mean()), worst))
+    return errors
+
+
+def model_notes(model: Model, body) -> list[str]:
+    """Sentences explaining where pybullet and the URDF spec differ for this model."""
+    notes = []
+    for joint in model.joints:
+        if joint.mimic is not None and joint.moves:
+            notes.append(f"joint {joint.name} mimics {joint.mimic.joint} (x{joint.mimic.multiplier:g} "
+                         f"{joint.mimic.offset:+g}): pybullet does not enforce <mimic>, so fk-verify sets it "
+                         "explicitly; a controller must do the same (or add a gear constraint)")
+        norm = float(np.linalg.norm(joint.axis))
+        if joint.moves and joint.axis_given and norm > 0 and abs(norm - 1.0) > 1e-9:
+            if joint.type == "prismatic":
+                notes.append(f"joint {joint.name} has a non-unit axis {joint.axis} (length {norm:g}): the URDF "
+                             f"spec normalises it, but pybullet moves the joint {norm:g} x q along it, so its "
+                             "child links disagree; write a unit axis")
+            else:
+                notes.append(f"joint {joint.name} has a non-unit axis {joint.axis} (length {norm:g}): pybullet "
+                             "and the URDF spec both normalise revolute axes; write a unit axis anyway")
+    root = model.root_link
+    if root.inertial is not None and any(abs(v) > 0 for v in (*root.inertial.origin.xyz, *root.inertial.origin.rpy)):
+        notes.append(f"root link {root.name} has an inertial origin {root.inertial.origin.xyz}: pybullet's base "
+                     "position (getBasePositionAndOrientation) is the COM, not the link frame; fk-verify undoes "
+                     "the offset (a floating-base controller must too)")
+    missing = [link.name for link in model.links if link.name not in body.link_index]
+    if missing:
+        notes.append(f"links not present in pybullet (merged or disconnected): {', '.join(missing)}")
+    return notes
+
+
+def compare(model: Model, body, samples: Samples) -> Comparison:
+    """Run both FKs over ``samples`` and measure every link."""
+    reference = kinematics.urdf_link_frames(model, samples.all_values, samples.count)
+    measured = pybullet_frames(body, samples)
+    return Comparison(links=compare_links(reference, measured), notes=model_notes(model, body), reference=reference)
