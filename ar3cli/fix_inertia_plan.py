@@ -171,8 +171,8 @@ def _write_frame_link(document: Document, plan: FixPlan, link, reason: str) -> N
 def _write_inertial(document: Document, plan: FixPlan, link, props: mp.MassProperties,
                     mass_source: str, geometry_source: str) -> None:
     """Queue the edits that make ``link``'s ``<inertial>`` say ``props`` (only fields that differ)."""
-    xyz = " ".join(number(v) for v in _clean(props.com))
-    tensor = _clean(props.inertia)
+    xyz = " ".join(number(v) for v in _clean(props.com, absolute=1e-12))
+    tensor = _clean(props.inertia, relative=1e-10)
     values = dict(zip(TENSOR_KEYS, (tensor[0, 0], tensor[0, 1], tensor[0, 2], tensor[1, 1], tensor[1, 2],
                                     tensor[2, 2])))
     new_tensor = {k: number(v) for k, v in values.items()}
@@ -249,11 +249,12 @@ def _same_numbers(old: str | None, new: str) -> bool:
     return len(a) == len(b) and all(math.isclose(x, y, rel_tol=1e-9, abs_tol=1e-15) for x, y in zip(a, b))
 
 
-def _clean(values: np.ndarray) -> np.ndarray:
-    """Zero out rounding noise (|v| < 1e-12 of the largest entry)."""
+def _clean(values: np.ndarray, relative: float = 0.0, absolute: float = 0.0) -> np.ndarray:
+    """Zero out rounding noise: entries below ``absolute`` or ``relative`` x the largest entry
+    (rotating a diagonal tensor by rpy angles leaves ~1e-17 off-diagonal residue)."""
     array = np.array(values, dtype=float)
     scale = float(np.max(np.abs(array))) if array.size else 0.0
-    array[np.abs(array) < 1e-12 * scale] = 0.0
+    array[np.abs(array) < max(absolute, relative * scale)] = 0.0
     return array
 
 

@@ -80,10 +80,16 @@ class FileResult:
 
 
 def number(value: float) -> str:
-    """A float as URDF text: 12 significant digits, no noise like ``1e-19`` next to larger values."""
+    """A float as URDF text: exactly as typed when it is short (a yaml limit, a --mass), else 10
+    significant digits (a computed number; far below any physical tolerance)."""
     if value == 0:
         return "0"
-    text = f"{value:.12g}"
+    text = repr(float(value))
+    digits = text.lower().split("e")[0].replace("-", "").replace(".", "").strip("0")
+    if len(digits) > 12:
+        text = f"{value:.10g}"
+    elif text.endswith(".0"):
+        text = text[:-2]
     return "0" if text in ("-0", "0") else text
 
 
