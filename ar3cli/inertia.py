@@ -30,6 +30,10 @@ IMPLAUSIBLE_FACTOR = 10.0
 (at the file's mass) is called implausible."""
 
 
+COM_FACTOR = 2.0
+"""A COM farther than this many radii of gyration from the geometry's COM is implausible."""
+
+
 class GeometryError(Exception):
     """The geometry cannot give mass properties (missing mesh, bad dimensions...)."""
 
@@ -237,20 +241,26 @@ def inertia_problem(model: Model, link: Link, moving: set[str], cache: dict | No
         return f"tensor not positive definite (principal moments {_moments(matrix)})"
     if not mp.satisfies_triangle_inequality(matrix):
         return f"tensor violates the triangle inequality (principal moments {_moments(matrix)})"
-    return _implausible(link, inertial.mass, matrix, cache)
+    return _implausible(link, inertial.mass, inertial.origin.xyz, matrix, cache)
 
 
 def _moments(matrix: np.ndarray) -> str:
     return ", ".join(f"{m:.3g}" for m in mp.principal_moments(matrix))
 
 
-def _implausible(link: Link, mass: float, matrix: np.ndarray, cache: dict | None) -> str | None:
+def _implausible(link: Link, mass: float, com, matrix: np.ndarray, cache: dict | None) -> str | None:
     try:
         geometry = geometry_mass(link, cache)
     except GeometryError:
         return None
     if geometry is None:
         return None
+    # radius of gyration of the geometry: sqrt(trace(I)/m) is 1.1 r for a sphere of radius r
+    gyration = math.sqrt(float(np.trace(geometry.props.inertia)) / geometry.volume)
+    offset = float(np.linalg.norm(np.asarray(com) - geometry.props.com))
+    if offset > COM_FACTOR * gyration:
+        return (f"implausible centre of mass: {offset:.3g} m from the {geometry.role} geometry's "
+                f"(the geometry's radius of gyration is {gyration:.3g} m)")
     expected = float(mp.principal_moments(geometry.props.inertia)[-1]) * mass / geometry.volume
     actual = float(mp.principal_moments(matrix)[-1])
     if expected > 0 and not (1 / IMPLAUSIBLE_FACTOR <= actual / expected <= IMPLAUSIBLE_FACTOR):

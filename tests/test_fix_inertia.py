@@ -290,3 +290,20 @@ def test_options_and_io_errors(cli, tmp_path, write_urdf):
     assert missing.code == 2 and "no such file" in missing.stderr
     assert sorted(os.listdir(tmp_path)) == ["other.urdf", "out.urdf", "robot.urdf"]  # no stray temp
     assert not [name for name in os.listdir(tmp_path) if "ar3cli-tmp" in name]
+
+
+def test_real_ar3_link_3_com_one_metre_away_is_caught_and_fixed(cli, tmp_path, shared_dir):
+    """The real ar3.urdf puts link_3's COM at z = -1.047 m, on a 10 cm part: flagged, mass kept, COM recomputed."""
+    real = shared_dir / "models" / "ar3_description"
+    original = (real / "urdf" / "ar3.urdf").read_text()
+    path = write(tmp_path / "ar3.urdf", original)
+    package = f"ar3_description={real}"
+    check = cli("fix-inertia", str(path), "--check", "--package-path", package, "--format", "json")
+    assert check.code == 1
+    changes = json.loads(check.stdout)["files"][0]["changes"]
+    assert {c["element"] for c in changes} == {"link link_3 <inertial>"}
+    assert cli("fix-inertia", str(path), "--package-path", package).code == 0
+    assert only_within(original, path.read_text(), [element_lines(original, r'name="link_3"', "</inertial>")])
+    mass, com, _ = inertial_of(path, "link_3")
+    assert mass == 0.1787 and np.linalg.norm(com) < 0.1
+    assert cli("fix-inertia", str(path), "--check", "--package-path", package).code == 0
