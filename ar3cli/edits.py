@@ -119,8 +119,7 @@ class Document:
     def format_attr(self, name: str, value: str) -> bytes:
         """``name="value"`` with the file's usual quote character."""
         quote = self.quote.decode()
-        escaped = value.replace("&", "&amp;").replace("<", "&lt;").replace(quote, "&quot;" if quote == '"' else "&apos;")
-        return f"{name}={quote}{escaped}{quote}".encode()
+        return f"{name}={quote}{_escape(value, quote)}{quote}".encode()
 
     # ---- splices -------------------------------------------------------------------------------
     def splice(self, start: int, end: int, new: bytes) -> None:
@@ -131,9 +130,7 @@ class Document:
         """Change one attribute's value (keeping its quote char) or append the attribute."""
         attribute = span.attributes.get(name)
         if attribute is not None:
-            quote = attribute.quote.decode()
-            escaped = value.replace("&", "&amp;").replace("<", "&lt;").replace(quote, "&quot;" if quote == '"' else "&apos;")
-            self.splice(attribute.value_start, attribute.value_end, escaped.encode())
+            self.splice(attribute.value_start, attribute.value_end, _escape(value, attribute.quote.decode()).encode())
         else:
             self.splice(span.attrs_end, span.attrs_end, b" " + self.format_attr(name, value))
 
@@ -195,6 +192,11 @@ class Document:
     @property
     def changed(self) -> bool:
         return bool(self._splices)
+
+
+def _escape(value: str, quote: str) -> str:
+    """An attribute value escaped for a given quote character."""
+    return value.replace("&", "&amp;").replace("<", "&lt;").replace(quote, "&quot;" if quote == '"' else "&apos;")
 
 
 # ---- the scanner -----------------------------------------------------------------------------

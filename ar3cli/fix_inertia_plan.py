@@ -20,7 +20,7 @@ import numpy as np
 
 from ar3cli import inertia
 from ar3cli import mass_properties as mp
-from ar3cli.edits import Document, Span
+from ar3cli.edits import Document
 from ar3cli.errors import UserError
 from ar3cli.fixing import Change, FixPlan, Skipped, number
 
