@@ -25,13 +25,6 @@ FRAME_LINK_MASS = 1e-6
 """kg written for a frame link (no geometry, fixed joint); see docs/commands/fix-inertia.md."""
 FRAME_LINK_INERTIA = 1e-12
 """kg*m^2 on each diagonal entry of a frame link's tensor."""
-IMPLAUSIBLE_FACTOR = 10.0
-"""A tensor whose largest principal moment is off by more than this factor from the geometry's
-(at the file's mass) is called implausible."""
-
-
-COM_FACTOR = 2.0
-"""A COM farther than this many radii of gyration from the geometry's COM is implausible."""
 
 
 class GeometryError(Exception):
@@ -190,91 +183,38 @@ def geometry_mass(link: Link, cache: dict | None = None) -> GeometryMass | None:
 
 
 # ---- which links need new inertia ------------------------------------------------------------
-def moving_links(model: Model) -> set[str]:
-    """Links downstream of a moving joint (they move, so their inertia matters)."""
-    moving: set[str] = set()
-    children: dict[str, list] = {}
-    for joint in model.joints:
-        children.setdefault(joint.parent or "", []).append(joint)
-    pending = [(link.name, False) for link in model.root_links()]
-    seen: set[str] = set()
-    while pending:
-        name, moved = pending.pop()
-        if name in seen:
-            continue
-        seen.add(name)
-        if moved:
-            moving.add(name)
-        for joint in children.get(name, []):
-            if joint.child:
-                pending.append((joint.child, moved or joint.moves))
-    return moving
-
-
 def is_frame_link(model: Model, link: Link) -> bool:
     """A pure frame (tool0, flange, tcp): no geometry, attached to its parent by a fixed joint."""
     joint = model.parent_joint(link.name)
     return not link.has_geometry and joint is not None and joint.type == "fixed"
 
 
-def inertia_problem(model: Model, link: Link, moving: set[str], cache: dict | None = None) -> str | None:
-    """Why the link's ``<inertial>`` needs fixing (the lint inertia criteria), or None.
-
-    Missing on a moving link; mass missing or <= 0; tensor missing, all zero with a mass, not
-    positive definite, violating the triangle inequality; or implausible for the geometry.
-    """
-    inertial = link.inertial
-    if inertial is None:
-        return "no <inertial> on a moving link" if link.name in moving else None
-    if inertial.mass is None or not math.isfinite(inertial.mass):
-        return "mass missing or malformed"
-    if inertial.mass <= 0:
-        if inertial.mass == 0 and link.name not in moving and model.parent_joint(link.name) is None:
-            return None  # a massless root is the usual way to say "static base" (pybullet honours it)
-        return f"mass {inertial.mass:g} <= 0"
-    if inertial.tensor is None or not all(map(math.isfinite, inertial.tensor)):
-        return "inertia tensor missing or malformed"
-    matrix = np.array(inertial.matrix())
-    if not np.any(matrix):
-        return "all-zero inertia tensor with a mass"
-    if not mp.is_positive_definite(matrix):
-        return f"tensor not positive definite (principal moments {_moments(matrix)})"
-    if not mp.satisfies_triangle_inequality(matrix):
-        return f"tensor violates the triangle inequality (principal moments {_moments(matrix)})"
-    return _implausible(link, inertial.mass, inertial.origin.xyz, matrix, cache)
-
-
-def _moments(matrix: np.ndarray) -> str:
-    return ", ".join(f"{m:.3g}" for m in mp.principal_moments(matrix))
-
-
-def _implausible(link: Link, mass: float, com, matrix: np.ndarray, cache: dict | None) -> str | None:
-    try:
-        geometry = geometry_mass(link, cache)
-    except GeometryError:
-        return None
-    if geometry is None:
-        return None
-    # radius of gyration of the geometry: sqrt(trace(I)/m) is 1.1 r for a sphere of radius r
-    gyration = math.sqrt(float(np.trace(geometry.props.inertia)) / geometry.volume)
-    offset = float(np.linalg.norm(np.asarray(com) - geometry.props.com))
-    if offset > COM_FACTOR * gyration:
-        return (f"implausible centre of mass: {offset:.3g} m from the {geometry.role} geometry's "
-                f"(the geometry's radius of gyration is {gyration:.3g} m)")
-    expected = float(mp.principal_moments(geometry.props.inertia)[-1]) * mass / geometry.volume
-    actual = float(mp.principal_moments(matrix)[-1])
-    if expected > 0 and not (1 / IMPLAUSIBLE_FACTOR <= actual / expected <= IMPLAUSIBLE_FACTOR):
-        return (f"implausible tensor: largest principal moment {actual:.3g} vs {expected:.3g} "
-                f"from the {geometry.role} geometry at the file's mass")
-    return None
-
-
 def links_needing_inertia(model: Model, cache: dict | None = None) -> dict[str, str]:
-    """``{link name: reason}`` for every link whose inertial the linter would flag."""
-    moving = moving_links(model)
-    found = {}
-    for link in model.links:
-        reason = inertia_problem(model, link, moving, cache)
-        if reason:
-            found[link.name] = reason
-    return found
+    """``{link name: "CODE name: message"}`` for every link the lint inertia rules (I001-I007) flag.
+
+    The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
+    so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
+    ``cache`` is accepted for callers that share a mesh cache; the rules keep their own.
+    """
+    from ar3cli.lint import Context, LintOptions, _suppressed_inline
+    from ar3cli.rules.inertia import RULES
+
+    context = Context(model, LintOptions())
+    found: dict[str, str] = {}
+    try:
+        for rule in RULES:
+            for hit in rule.check(context):
+                element = _owning_link(hit.element)
+                if element is None or _suppressed_inline(hit.element, rule.code):
+                    continue
+                found.setdefault(element.get("name", ""), f"{rule.code} {rule.name}: {hit.message}")
+    finally:
+        context.close()
+    return {link.name: found[link.name] for link in model.links if link.name in found}
+
+
+def _owning_link(element):
+    """The ``<link>`` element a hit's element belongs to (itself, or an ancestor)."""
+    while element is not None and element.tag != "link":
+        element = element.getparent()
+    return element

@@ -243,12 +243,15 @@ class Session:
         base_position: Iterable[float] = (0.0, 0.0, 0.0),
         base_orientation: Iterable[float] = (0.0, 0.0, 0.0, 1.0),
         self_collision: str | None = None,
+        maximal_coordinates: bool = False,
     ) -> Body:
         """Load ``model`` with explicit flags; raises UserError quoting pybullet's reason on failure.
 
         Default flags: ``URDF_USE_INERTIA_FROM_FILE`` (pybullet's default recomputes every tensor
         from the collision AABB) and ``URDF_MAINTAIN_LINK_ORDER``. ``self_collision="all-pairs"``
         adds ``URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_INCLUDE_PARENT``.
+        ``maximal_coordinates=True`` loads a free object as a plain rigid body instead of a
+        multibody (``useMaximalCoordinates``): its contacts are cheaper to solve.
         """
         p = self.p
         if flags is None:
@@ -259,7 +262,8 @@ class Session:
         with capture_fds() as captured:
             try:
                 body_id = p.loadURDF(str(urdf_path), list(base_position), list(base_orientation),
-                                     useFixedBase=fixed_base, flags=flags, physicsClientId=self.client)
+                                     useFixedBase=fixed_base, flags=flags,
+                                     useMaximalCoordinates=maximal_coordinates, physicsClientId=self.client)
             except p.error:
                 body_id = -1
         messages = [message.replace(str(urdf_path), str(model.path)) for message in captured.messages]

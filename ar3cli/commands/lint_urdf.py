@@ -1,0 +1,130 @@
+"""``ar3cli lint-urdf``: static (and optionally simulated) checks of URDF / xacro files."""
+
+from __future__ import annotations
+
+import enum
+import os
+import sys
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
+from ar3cli.options import PackagePathOption, XacroArgOption
+
+
+class LintFormat(str, enum.Enum):
+    """Output formats of lint-urdf (the common text/json plus CI formats)."""
+
+    text = "text"
+    json = "json"
+    sarif = "sarif"
+    github = "github"
+    markdown = "markdown"
+
+
+class FailOn(str, enum.Enum):
+    error = "error"
+    warning = "warning"
+    info = "info"
+
+
+def lint_urdf(
+    paths: Annotated[list[Path], typer.Argument(help="URDF/xacro files, or folders searched for *.urdf and *.xacro.",
+                                                show_default=False)],
+    format: Annotated[LintFormat, typer.Option("--format", "-f", help="text (table), json, sarif (SARIF 2.1.0), "
+                                                                      "github (workflow annotations) or markdown.")]
+    = LintFormat.text,
+    select: Annotated[Optional[list[str]], typer.Option("--select", metavar="CODES",
+                                                        help="Only these rule codes or prefixes (comma-separated, "
+                                                             "repeatable; overrides the config's select).")] = None,
+    ignore: Annotated[Optional[list[str]], typer.Option("--ignore", metavar="CODES",
+                                                        help="Skip these rule codes or prefixes (added to the "
+                                                             "config's ignore).")] = None,
+    fail_on: Annotated[Optional[FailOn], typer.Option("--fail-on", help="Exit 1 when a finding is at least this "
+                                                                        "severe (default: error, or the config's fail-on).",
+                                                      show_default=False)] = None,
+    exit_zero: Annotated[bool, typer.Option("--exit-zero", help="Exit 0 even when there are findings.")] = False,
+    sim: Annotated[bool, typer.Option("--sim", help="Also load each model in PyBullet (P rules): load errors, "
+                                                    "self-collision at home, inertia PyBullet really uses, stability.")]
+    = False,
+    no_config: Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
+    = False,
+    package_path: PackagePathOption = None,
+    xacro_arg: XacroArgOption = None,
+) -> None:
+    """Check URDF and xacro files for mistakes that break ROS tools or make PyBullet misbehave.
+
+    Every finding has a stable rule code, a severity, a location and a fix; see docs/rules.md.
+    Exit codes: 0 clean, 1 findings at or above --fail-on, 2 usage or I/O error.
+    """
+    from ar3cli.findings import Severity
+    from ar3cli.lint import LintOptions, lint_paths, summarize
+    from ar3cli.lint_config import LintConfig, load_config
+    from ar3cli.packages import parse_package_paths
+    from ar3cli.rules import validate_patterns
+    from ar3cli.xacro_expand import parse_xacro_args
+
+    config = LintConfig() if no_config else load_config()
+    try:
+        options = LintOptions(
+            select=(validate_patterns(_split(select), "--select") if select else config.select) or ["ALL"],
+            ignore=[*config.ignore, *validate_patterns(_split(ignore), "--ignore")],
+            per_file_ignores=config.per_file_ignores, severity=config.severity, sim=sim,
+            package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
+    results = lint_paths(paths, options)
+    if not results:
+        raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
+    summary = summarize(results, threshold)
+    render_lint(results, summary, options, LintFormat(format))
+    failed = summary["failed"] and not exit_zero
+    raise typer.Exit(EXIT_PROBLEMS if failed else EXIT_OK)
+
+
+def _split(items: list[str] | None) -> list[str]:
+    return [part for item in items or [] for part in item.split(",")]
+
+
+def summary_line(summary: dict) -> str:
+    files = summary["files"]
+    clean = files - summary["files_with_findings"]
+    verdict = "FAILED" if summary["failed"] else "passed"
+    return (f"{verdict}: {files} file{'s' if files != 1 else ''} checked, {summary['error']} errors, "
+            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean (fail-on: {summary['fail_on']})")
+
+
+def render_lint(results, summary: dict, options, fmt: LintFormat) -> None:
+    """Print the findings in ``fmt`` (text and json through the shared output layer)."""
+    from ar3cli.output import Report, Table, emit_json, render
+
+    findings = [f for result in results for f in result.findings]
+    if fmt is LintFormat.sarif:
+        from ar3cli.output_sarif import sarif_document
+
+        emit_json(sarif_document(findings, options.rules()))
+    elif fmt is LintFormat.github:
+        from ar3cli.output_github import annotation, markdown_table
+
+        for finding in findings:
+            print(annotation(finding))
+        print(summary_line(summary))
+        step_summary = os.environ.get("GITHUB_STEP_SUMMARY")
+        if step_summary:  # GitHub Actions: the reviewer sees the table on the run's summary page
+            with open(step_summary, "a", encoding="utf-8") as handle:
+                handle.write(markdown_table(findings, summary_line(summary)))
+    elif fmt is LintFormat.markdown:
+        from ar3cli.output_github import markdown_table
+
+        sys.stdout.write(markdown_table(findings, summary_line(summary)))
+    else:
+        tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
+                        rows=[[f.location, f.rule, f.severity.value, f.message, f.hint] for f in result.findings],
+                        status_column="severity")
+                  for result in results if result.findings]
+        data = {"files": [r.to_dict() for r in results], "findings": [f.to_dict() for f in findings],
+                "summary": summary}
+        render(Report(data=data, tables=tables, lines=[summary_line(summary)], ok=not summary["failed"]), fmt.value)

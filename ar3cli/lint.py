@@ -1,0 +1,274 @@
+"""The lint engine: collect files, load each once, run the selected rules, apply configuration.
+
+One file's trouble never stops the run: a file that cannot be read, parsed or expanded becomes a
+finding of the F family on that file (:func:`load_failure`) and the engine moves on. Rules yield
+:class:`~ar3cli.rules.base.Hit` objects; this module turns them into located
+:class:`~ar3cli.findings.Finding` objects, drops the suppressed ones (inline comments,
+``per-file-ignores``) and applies severity overrides. Nothing here imports pybullet: ``--sim`` rules
+open a :class:`~ar3cli.sim.Session` lazily through :attr:`Context.session`.
+"""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+import re
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ar3cli.errors import UserError
+from ar3cli.findings import Finding, Severity
+from ar3cli.rules import REGISTRY, RULES, Hit, Rule, matches
+
+ROBOT_SUFFIXES = (".urdf", ".xacro")
+_SKIP_DIRS = {".git", ".hg", ".svn", "__pycache__", "node_modules", ".venv", "venv", ".tox"}
+_INLINE = re.compile(r"ar3cli:\s*ignore(?!-file)(?:\[([^\]]*)\])?")
+_FILE_LEVEL = re.compile(rb"ar3cli:\s*ignore-file(?:\[([^\]]*)\])?")
+
+
+@dataclass
+class LintOptions:
+    """What to check and how: the merged command line and ``[tool.ar3cli.lint]`` configuration."""
+
+    select: list[str] = field(default_factory=lambda: ["ALL"])
+    ignore: list[str] = field(default_factory=list)
+    per_file_ignores: dict[str, list[str]] = field(default_factory=dict)
+    severity: dict[str, Severity] = field(default_factory=dict)
+    sim: bool = False
+    package_paths: Mapping[str, Path] = field(default_factory=dict)
+    xacro_args: Mapping[str, str] = field(default_factory=dict)
+
+    def rules(self) -> list[Rule]:
+        """Selected rules in registry order; simulation rules only with ``sim``."""
+        return [r for r in RULES if matches(r.code, self.select) and not matches(r.code, self.ignore)
+                and (self.sim or not r.needs_sim)]
+
+
+@dataclass
+class FileResult:
+    """One linted file: its display path, whether it loaded, and its findings."""
+
+    path: str
+    loaded: bool
+    findings: list[Finding]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings)}
+
+
+class Context:
+    """What a rule sees: the model, plus lazily built shared helpers (geometry boxes, the PyBullet session)."""
+
+    def __init__(self, model, options: LintOptions) -> None:
+        self.model = model
+        self.options = options
+        self._bounds: dict[str, Any] = {}
+        self._session = None
+
+    def link_bounds(self, link):
+        """Box around the link's collision (else visual) shapes in its frame, or None."""
+        if link.name not in self._bounds:
+            from ar3cli.rules.geometry import link_bounds
+
+            self._bounds[link.name] = link_bounds(link)
+        return self._bounds[link.name]
+
+    @property
+    def session(self):
+        """A PyBullet session for ``--sim`` rules, opened on first use (pybullet is imported only then)."""
+        if self._session is None:
+            from ar3cli.sim import Session
+
+            self._session = Session(gravity=-9.81, file_caching=True)
+        return self._session
+
+    def close(self) -> None:
+        if self._session is not None:
+            self._session.close()
+            self._session = None
+
+
+def display_path(path: Path) -> str:
+    """The path relative to the current directory when it is below it, else as given."""
+    try:
+        return Path(os.path.relpath(path)).as_posix() if not os.path.relpath(path).startswith("..") else str(path)
+    except ValueError:  # another drive on Windows
+        return str(path)
+
+
+def collect_files(paths: Iterable[Path]) -> list[Path]:
+    """Files to lint: given files as they are, folders searched for ``*.urdf`` / ``*.xacro`` (sorted).
+
+    A path that does not exist is a usage error (exit 2): it is a typo, not a finding.
+    """
+    found: list[Path] = []
+    for path in paths:
+        if path.is_dir():
+            for folder, dirs, files in os.walk(path):
+                dirs[:] = sorted(d for d in dirs if d not in _SKIP_DIRS)
+                found += [Path(folder) / name for name in sorted(files) if name.lower().endswith(ROBOT_SUFFIXES)]
+        elif path.exists() or path.is_symlink():
+            found.append(path)
+        else:
+            raise UserError(f"{path}: no such file or directory")
+    unique: dict[str, Path] = {}
+    for path in found:
+        unique.setdefault(os.path.normpath(path), path)
+    return list(unique.values())
+
+
+def lint_paths(paths: Iterable[Path], options: LintOptions) -> list[FileResult]:
+    """Lint every file under ``paths``; one :class:`FileResult` per file, in order."""
+    rules = options.rules()
+    return [lint_file(path, rules, options) for path in collect_files(paths)]
+
+
+def lint_file(path: Path, rules: list[Rule], options: LintOptions) -> FileResult:
+    """Load one file and run ``rules`` on it; a load failure is a finding, never an exception."""
+    from ar3cli.model import load_model
+
+    shown = display_path(path)
+    try:
+        model = load_model(path, options.package_paths, options.xacro_args)
+    except UserError as exc:
+        finding = load_failure(path, shown, exc.message)
+        kept = [f for f in [finding] if _selected(f.rule, rules) and not _file_ignored(shown, f.rule, options)]
+        return FileResult(shown, False, [_override(f, options) for f in kept])
+    except RecursionError:
+        finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
+        return FileResult(shown, False, [_override(finding, options)] if _selected("F002", rules) else [])
+    context = Context(model, options)
+    locator = Locator(model)
+    file_ignores = _file_level_ignores(model.source_bytes)
+    findings: list[Finding] = []
+    try:
+        for rule in rules:
+            if rule.check is None:
+                continue
+            for hit in rule.check(context):
+                if matches(rule.code, file_ignores) or _file_ignored(shown, rule.code, options):
+                    continue
+                if hit.element is not None and _suppressed_inline(hit.element, rule.code):
+                    continue
+                line, column = locator.locate(hit)
+                findings.append(_override(Finding(rule.code, rule.severity, hit.message, shown, line, column,
+                                                  hit.hint or rule.fix), options))
+    finally:
+        context.close()
+    findings.sort(key=lambda f: (f.line, f.column, f.rule))
+    return FileResult(shown, True, findings)
+
+
+def load_failure(path: Path, shown: str, message: str) -> Finding:
+    """Turn the loader's one-line UserError into an F001-F004 finding on the file."""
+    line = 0
+    for prefix in (str(path), shown):
+        match = re.match(re.escape(prefix) + r"(?::(\d+))?: ", message)
+        if match:
+            line = int(match.group(1) or 0)
+            message = message[match.end():]
+            break
+    if any(key in message for key in ("no such file", "is a directory", "cannot read", "MB limit")):
+        code = "F001"
+    elif "xacro error" in message or "$(find" in message:
+        code = "F004"
+    elif message.startswith("root element is"):
+        code = "F003"
+    else:
+        code = "F002"
+    rule = REGISTRY[code]
+    return Finding(code, rule.severity, message, shown, line, 1 if line else 0, rule.fix)
+
+
+class Locator:
+    """Line and column of a hit: in the parsed text, or mapped back into the .xacro source."""
+
+    def __init__(self, model) -> None:
+        self.model = model
+        self._source_text: str | None = None
+
+    def locate(self, hit: Hit) -> tuple[int, int]:
+        element = hit.element
+        if element is None:
+            return hit.line, (1 if hit.line else 0)
+        if not self.model.is_xacro:
+            line = element.sourceline or 0
+            return line, (self.model.column_of(element) if line else 0)
+        return self._xacro_position(element)
+
+    def _xacro_position(self, element) -> tuple[int, int]:
+        """Position of the enclosing link/joint (by its name) in the xacro source; (0, 0) if ambiguous."""
+        from ar3cli.xmlsource import decode_text
+
+        if self._source_text is None:
+            self._source_text = decode_text(self.model.source_bytes)
+        node = element
+        while node is not None and not (node.tag in ("link", "joint") and node.get("name")):
+            node = node.getparent()
+        if node is None:
+            pattern = r"<robot\b"
+        else:
+            pattern = rf"""<{node.tag}\b[^>]*?\bname\s*=\s*["']{re.escape(node.get("name"))}["']"""
+        found = list(re.finditer(pattern, self._source_text))
+        if len(found) != 1:
+            return 0, 0
+        start = found[0].start()
+        line = self._source_text.count("\n", 0, start) + 1
+        return line, start - (self._source_text.rfind("\n", 0, start) + 1) + 1
+
+
+def _selected(code: str, rules: list[Rule]) -> bool:
+    return any(rule.code == code for rule in rules)
+
+
+def _file_ignored(shown: str, code: str, options: LintOptions) -> bool:
+    for pattern, codes in options.per_file_ignores.items():
+        if (fnmatch.fnmatch(shown, pattern) or fnmatch.fnmatch(Path(shown).name, pattern)) and matches(code, codes):
+            return True
+    return False
+
+
+def _file_level_ignores(source: bytes) -> list[str]:
+    codes: list[str] = []
+    for match in _FILE_LEVEL.finditer(source):
+        codes += _codes(match.group(1).decode("ascii", "replace") if match.group(1) is not None else None)
+    return codes
+
+
+def _codes(text: str | None) -> list[str]:
+    """Codes listed in ``ignore[...]``; no list means every rule."""
+    if text is None:
+        return ["ALL"]
+    return [code.strip().upper() for code in text.split(",") if code.strip()] or ["ALL"]
+
+
+def _suppressed_inline(element, code: str) -> bool:
+    """True when the element or an ancestor holds a ``<!-- ar3cli: ignore[...] -->`` child comment."""
+    from lxml import etree
+
+    node = element
+    while node is not None:
+        for child in node.iterchildren(etree.Comment):
+            match = _INLINE.search(child.text or "")
+            if match and matches(code, _codes(match.group(1))):
+                return True
+        node = node.getparent()
+    return False
+
+
+def _override(finding: Finding, options: LintOptions) -> Finding:
+    severity = options.severity.get(finding.rule)
+    if severity is None or severity == finding.severity:
+        return finding
+    return Finding(finding.rule, severity, finding.message, finding.path, finding.line, finding.column, finding.hint)
+
+
+def summarize(results: list[FileResult], fail_on: Severity) -> dict[str, Any]:
+    """Counts for the summary line and the JSON ``summary`` object."""
+    findings = [f for r in results for f in r.findings]
+    counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}
+    return {"files": len(results), "files_with_findings": sum(bool(r.findings) for r in results),
+            "findings": len(findings), **counts, "fail_on": fail_on.value,
+            "failed": any(f.severity >= fail_on for f in findings)}

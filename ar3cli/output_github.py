@@ -1,0 +1,45 @@
+"""GitHub Actions workflow-command annotations and a Markdown table for ``$GITHUB_STEP_SUMMARY``."""
+
+from __future__ import annotations
+
+from ar3cli.findings import Finding, Severity
+
+COMMANDS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "notice"}
+
+
+def escape_data(text: str) -> str:
+    """Escape a command's message (workflow-commands spec: %, CR, LF)."""
+    return text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+
+
+def escape_property(text: str) -> str:
+    """Escape a property value: the message escapes plus ``:`` and ``,``."""
+    return escape_data(text).replace(":", "%3A").replace(",", "%2C")
+
+
+def annotation(finding: Finding) -> str:
+    """``::error file=PATH,line=L,col=C,title=CODE::message (fix: hint)``."""
+    properties = [f"file={escape_property(finding.path)}"]
+    if finding.line:
+        properties += [f"line={finding.line}", f"col={max(finding.column, 1)}"]
+    properties.append(f"title={escape_property(finding.rule)}")
+    message = finding.message + (f" (fix: {finding.hint})" if finding.hint else "")
+    return f"::{COMMANDS[finding.severity]} {','.join(properties)}::{escape_data(message)}"
+
+
+def markdown_cell(text: str) -> str:
+    """Text safe inside a table cell: pipes escaped, and ``<inertial>`` shown, not eaten as an HTML tag."""
+    text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
+
+
+def markdown_table(findings: list[Finding], summary_line: str) -> str:
+    """A findings table in GitHub-flavoured Markdown, ending with the summary line."""
+    lines = ["## ar3cli lint-urdf", ""]
+    if findings:
+        lines += ["| location | rule | severity | message | hint |", "| --- | --- | --- | --- | --- |"]
+        lines += [f"| `{markdown_cell(f.location)}` | {f.rule} | {f.severity.value} | {markdown_cell(f.message)} | "
+                  f"{markdown_cell(f.hint)} |" for f in findings]
+        lines.append("")
+    lines.append(summary_line)
+    return "\n".join(lines) + "\n"

@@ -1,0 +1,37 @@
+"""The rule registry: every lint rule, by stable code.
+
+Codes are grouped by family prefix (F file, S structure, J joints, I inertia, G geometry,
+P simulation) and never reused. To add a rule: write one decorated function in its family module
+and add it to that module's ``RULES`` tuple; docs/rules.md is generated from this registry
+(``python -m ar3cli.rules.docs > docs/rules.md``) and a test keeps the two equal.
+"""
+
+from __future__ import annotations
+
+from ar3cli.rules import file, geometry, inertia, joints, sim, structure
+from ar3cli.rules.base import FAMILIES, Hit, Rule
+
+RULES: tuple[Rule, ...] = (*file.RULES, *structure.RULES, *joints.RULES, *inertia.RULES, *geometry.RULES,
+                           *sim.RULES)
+REGISTRY: dict[str, Rule] = {r.code: r for r in RULES}
+assert len(REGISTRY) == len(RULES), "duplicate rule code"
+
+__all__ = ["FAMILIES", "REGISTRY", "RULES", "Hit", "Rule", "matches", "validate_patterns"]
+
+
+def matches(code: str, patterns) -> bool:
+    """True when ``code`` is selected by any pattern: a full code, a prefix (``J``, ``J00``) or ``ALL``."""
+    return any(pattern == "ALL" or code.startswith(pattern) for pattern in patterns)
+
+
+def validate_patterns(patterns, where: str) -> list[str]:
+    """Upper-case the patterns and check each one selects at least one rule; ValueError otherwise."""
+    cleaned = []
+    for raw in patterns:
+        pattern = str(raw).strip().upper()
+        if not pattern:
+            continue
+        if pattern != "ALL" and not any(code.startswith(pattern) for code in REGISTRY):
+            raise ValueError(f"{where}: unknown rule code {raw!r} (codes look like F001, J006, or a prefix like J)")
+        cleaned.append(pattern)
+    return cleaned

@@ -1,0 +1,119 @@
+"""The pieces every lint rule is made of: :class:`Rule`, :class:`Hit` and the :func:`rule` decorator.
+
+A rule is a generator function ``check(ctx) -> Iterator[Hit]`` plus its metadata (stable code,
+severity, title, documentation with a failing and a passing example). Rules never build
+:class:`~ar3cli.findings.Finding` objects themselves: they yield a :class:`Hit` naming the
+element at fault, and the engine (:mod:`ar3cli.lint`) turns it into a Finding with path, line,
+column, suppression and configured severity. That keeps each rule a few lines of logic.
+"""
+
+from __future__ import annotations
+
+import textwrap
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from ar3cli.findings import Severity
+
+if TYPE_CHECKING:
+    from ar3cli.lint import Context
+
+FAMILIES = {
+    "F": "file",
+    "S": "structure",
+    "J": "joints",
+    "I": "inertia",
+    "G": "geometry",
+    "P": "sim",
+}
+"""Code prefix -> family name; the prefix is the first letter of every code."""
+
+
+@dataclass(frozen=True)
+class Hit:
+    """One problem as a rule reports it: a message about ``element`` (an lxml element) or ``line``.
+
+    ``hint`` replaces the rule's default hint when the fix depends on the case.
+    """
+
+    message: str
+    element: Any = None
+    line: int = 0
+    hint: str | None = None
+
+
+Check = Callable[["Context"], Iterator[Hit]]
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A lint rule: metadata for docs/config/SARIF plus the ``check`` generator.
+
+    ``bad`` and ``good`` are complete small URDF documents: the docs show them and the tests lint
+    them (``bad`` must trigger the rule, ``good`` must not), so the documentation cannot drift.
+    ``check`` is None for file rules the engine emits itself while loading.
+    """
+
+    code: str
+    name: str
+    severity: Severity
+    title: str
+    why: str
+    fix: str
+    bad: str
+    good: str
+    check: Check | None = None
+    needs_sim: bool = False
+
+    @property
+    def family(self) -> str:
+        return FAMILIES[self.code[0]]
+
+    @property
+    def anchor(self) -> str:
+        """The heading anchor of this rule in docs/rules.md."""
+        return f"{self.code.lower()}-{self.name}"
+
+
+def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str, bad: str, good: str,
+         needs_sim: bool = False) -> Callable[[Check | None], Rule]:
+    """Decorator turning a check function into a :class:`Rule` (the function's name is unused)."""
+
+    def wrap(check: Check | None) -> Rule:
+        return Rule(code=code, name=name, severity=Severity(severity), title=title,
+                    why=" ".join(why.split()), fix=" ".join(fix.split()),
+                    bad=textwrap.dedent(bad).strip() + "\n", good=textwrap.dedent(good).strip() + "\n",
+                    check=check, needs_sim=needs_sim)
+
+    return wrap
+
+
+def engine_rule(code: str, name: str, severity: str, title: str, **docs: str) -> Rule:
+    """A rule whose findings the engine produces (load failures), with no check of its own."""
+    return rule(code, name, severity, title, **docs)(None)
+
+
+def robot(body: str, name: str = "r") -> str:
+    """Wrap URDF elements in a ``<robot>`` document (for the doc examples)."""
+    inner = textwrap.indent(textwrap.dedent(body).strip(), "  ")
+    return f'<?xml version="1.0"?>\n<robot name="{name}">\n{inner}\n</robot>\n'
+
+
+LINK_INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
+"""A valid inertial for a 1 kg, ~0.25 m body, used by doc examples."""
+
+
+def arm(joint_extra: str = '<limit lower="-1" upper="1" effort="10" velocity="1"/>',
+        joint_type: str = "revolute", link_extra: str = LINK_INERTIAL,
+        base_extra: str = "", joint_attrs: str = "") -> str:
+    """A two-link robot with one joint, parameterised for the doc examples."""
+    return robot(f"""
+        <link name="base">{base_extra}</link>
+        <link name="arm">{link_extra}</link>
+        <joint name="j1" type="{joint_type}"{joint_attrs}>
+          <parent link="base"/><child link="arm"/>
+          <axis xyz="0 0 1"/>
+          {joint_extra}
+        </joint>
+        """)

@@ -1,0 +1,133 @@
+"""File rules (F): can the file be read and parsed, and would a strict parser or ROS accept it."""
+
+from __future__ import annotations
+
+import math
+import re
+from collections.abc import Iterator
+
+from ar3cli.rules.base import Hit, engine_rule, robot, rule
+
+unreadable = engine_rule(
+    "F001", "unreadable", "error", "File cannot be read",
+    why="The path is missing, a directory, too large, or not readable; nothing else can be checked.",
+    fix="Check the path and its permissions.",
+    bad="(a path that does not exist)", good=robot('<link name="base"/>'))
+
+not_xml = engine_rule(
+    "F002", "not-xml", "error", "File is not well-formed XML",
+    why="Every URDF consumer parses XML first; a syntax error (or an empty file, binary junk, or an "
+        "entity declaration, which ar3cli refuses because entities can explode or read other files) "
+        "stops all of them.",
+    fix="Fix the XML at the reported line; remove any <!DOCTYPE>/<!ENTITY>.",
+    bad='<?xml version="1.0"?>\n<robot name="r">\n  <link name="base">\n</robot>',
+    good=robot('<link name="base"/>'))
+
+not_robot = engine_rule(
+    "F003", "not-robot", "error", "Root element is not <robot>",
+    why="A URDF's root element must be <robot>; an SDF, MJCF or other XML file is not a URDF.",
+    fix="Lint only URDF files, or convert the file to URDF.",
+    bad='<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>',
+    good=robot('<link name="base"/>'))
+
+xacro_failed = engine_rule(
+    "F004", "xacro-failed", "error", "Xacro expansion failed",
+    why="A .xacro file must expand before it can be checked; undefined properties, missing includes "
+        "or unknown packages stop the expansion.",
+    fix="Pass --xacro-arg NAME:=VALUE / --package-path NAME=DIR, or fix the xacro at the reported place.",
+    bad='<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">\n'
+        '  <link name="${undefined_prefix}base"/>\n</robot>',
+    good='<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">\n'
+         '  <xacro:property name="prefix" value="my_"/>\n  <link name="${prefix}base"/>\n</robot>')
+
+_PORTABILITY_QUIRKS = ("version-", "leading-junk", "trailing-junk")
+
+
+@rule("F005", "strict-parser", "warning", "File needs a tolerant XML parser",
+      why="""Strict parsers (urdfdom's TinyXML2, Python's xml.etree, ROS tools) reject
+      version="0.0" declarations, blank lines or junk before the declaration, and bytes after the
+      root element. PyBullet and ar3cli tolerate them, so such files work in one tool and fail in
+      the next.""",
+      fix='Write <?xml version="1.0"?> on the very first line and nothing after </robot>.',
+      bad='<?xml version="0.0"?>\n<robot name="r">\n  <link name="base"/>\n</robot>\n',
+      good=robot('<link name="base"/>'))
+def strict_parser(ctx) -> Iterator[Hit]:
+    for quirk in ctx.model.quirks:
+        if quirk.code.startswith(_PORTABILITY_QUIRKS):
+            yield Hit(quirk.message, line=quirk.line)
+
+
+_SUBSTITUTION = re.compile(r"\$\(|\$\{")
+
+
+@rule("F006", "unexpanded-substitution", "error", "Unexpanded $(...) or ${...} substitution",
+      why="""A URDF containing $(find pkg) or ${var} was written from a xacro file without
+      expanding it (or by a broken generator); every URDF parser reads the text literally, so
+      mesh paths and numbers are wrong.""",
+      fix="Expand the xacro (xacro robot.urdf.xacro > robot.urdf) or lint the .xacro itself.",
+      bad=robot('<link name="base"><visual><geometry><mesh filename="$(find pkg)/base.stl"/></geometry></visual></link>'),
+      good=robot('<link name="base"><visual><geometry><box size="1 1 1"/></geometry></visual></link>'))
+def unexpanded_substitution(ctx) -> Iterator[Hit]:
+    for element in ctx.model.root.iter():
+        if not isinstance(element.tag, str):
+            continue
+        for key, value in element.attrib.items():
+            if _SUBSTITUTION.search(value):
+                yield Hit(f"<{element.tag} {key}=\"{value}\"> contains an unexpanded substitution", element)
+
+
+NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
+    "origin": {"xyz": 3, "rpy": 3},
+    "axis": {"xyz": 3},
+    "box": {"size": 3},
+    "mesh": {"scale": 0},  # 1 or 3 numbers (one number is G007's business)
+    "cylinder": {"radius": 1, "length": 1},
+    "capsule": {"radius": 1, "length": 1},
+    "sphere": {"radius": 1},
+    "mass": {"value": 1},
+    "inertia": {key: 1 for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
+    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
+    "dynamics": {"damping": 1, "friction": 1},
+    "mimic": {"multiplier": 1, "offset": 1},
+    "safety_controller": {"soft_lower_limit": 1, "soft_upper_limit": 1, "k_position": 1, "k_velocity": 1},
+    "color": {"rgba": 4},
+}
+"""Element tag -> attribute -> how many numbers it must hold (0: one or three)."""
+
+
+def number_problem(text: str, count: int) -> str | None:
+    """Why ``text`` is not ``count`` finite numbers, or None when it is fine."""
+    parts = text.split()
+    expected = (1, 3) if count == 0 else (count,)
+    if len(parts) not in expected:
+        want = "1 or 3" if count == 0 else str(count)
+        return f"has {len(parts)} number{'s' if len(parts) != 1 else ''}, expected {want}"
+    for part in parts:
+        try:
+            value = float(part)
+        except ValueError:
+            return f"'{part}' is not a number"
+        if not math.isfinite(value):
+            return f"holds {part}, which is not a finite number"
+    return None
+
+
+@rule("F007", "malformed-number", "error", "Malformed number or wrong number of components",
+      why="""xyz/rpy/size/scale need exactly three numbers, rgba four, masses and limits one.
+      Parsers disagree on what to do with "0 0" or "1,0,0": urdfdom refuses the file, PyBullet
+      silently reads zeros, and nan or inf propagate into the physics as NaN states.""",
+      fix="Write the right number of space-separated finite numbers (no commas, no units).",
+      bad=robot('<link name="base"><visual><origin xyz="0 0"/><geometry><box size="1 1 1"/></geometry></visual></link>'),
+      good=robot('<link name="base"><visual><origin xyz="0 0 0"/><geometry><box size="1 1 1"/></geometry></visual></link>'))
+def malformed_number(ctx) -> Iterator[Hit]:
+    for element in ctx.model.root.iter(*NUMERIC_ATTRIBUTES):
+        for key, count in NUMERIC_ATTRIBUTES[element.tag].items():
+            text = element.get(key)
+            if text is None or _SUBSTITUTION.search(text):
+                continue  # unexpanded substitutions are F006's
+            problem = number_problem(text, count)
+            if problem:
+                yield Hit(f"<{element.tag} {key}=\"{text}\"> {problem}", element)
+
+
+RULES = (unreadable, not_xml, not_robot, xacro_failed, strict_parser, unexpanded_substitution, malformed_number)

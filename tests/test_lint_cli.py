@@ -1,0 +1,225 @@
+"""lint-urdf through the real CLI: formats, configuration, suppression, exit codes, bad input."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from ar3cli.rules.base import arm
+from tests.conftest import ASSETS, SHARED
+
+ZERO_EFFORT = arm(joint_extra='<limit lower="-1" upper="1" effort="0" velocity="1"/>')  # J008 warning
+NO_LIMIT = arm(joint_extra="")  # J001 error
+
+
+def test_json_document_and_exit_code(cli, write_urdf):
+    path = write_urdf(NO_LIMIT)
+    result = cli("lint-urdf", str(path), "--format", "json")
+    assert result.code == 1, result.stderr
+    doc = json.loads(result.stdout)
+    assert set(doc) == {"files", "findings", "summary"}
+    (finding,) = [f for f in doc["findings"] if f["rule"] == "J001"]
+    assert set(finding) == {"path", "line", "column", "rule", "severity", "message", "hint"}
+    assert finding["severity"] == "error" and finding["line"] == 5 and "'j1'" in finding["message"]
+    assert doc["summary"]["error"] >= 1 and doc["summary"]["failed"] is True
+
+
+def test_fail_on_and_exit_zero(cli, write_urdf):
+    path = str(write_urdf(ZERO_EFFORT))
+    assert cli("lint-urdf", path).code == 0  # a warning does not fail by default
+    assert cli("lint-urdf", path, "--fail-on", "warning").code == 1
+    assert cli("lint-urdf", path, "--fail-on", "warning", "--exit-zero").code == 0
+
+
+def test_text_output_has_location_code_and_summary(cli, write_urdf):
+    result = cli("lint-urdf", str(write_urdf(NO_LIMIT)))
+    assert "robot.urdf:5:3" in result.stdout and "J001" in result.stdout
+    assert "FAILED: 1 file checked, 1 errors" in result.stdout
+
+
+def test_sarif_validates_against_the_schema(cli, write_urdf, tmp_path):
+    jsonschema = pytest.importorskip("jsonschema")
+    schema_path = SHARED / "data" / "sarif-schema-2.1.0.json"
+    if not schema_path.is_file():
+        pytest.skip(f"SARIF schema not found at {schema_path}")
+    write_urdf(NO_LIMIT)
+    (tmp_path / "junk.urdf").write_bytes(b"\x00\xff binary")
+    result = cli("lint-urdf", str(tmp_path), "--format", "sarif", cwd=tmp_path)
+    doc = json.loads(result.stdout)
+    jsonschema.validate(doc, json.loads(schema_path.read_text()))
+    run = doc["runs"][0]
+    results = {r["ruleId"]: r for r in run["results"]}
+    assert results["J001"]["locations"][0]["physicalLocation"]["artifactLocation"]["uri"] == "robot.urdf"
+    assert results["J001"]["locations"][0]["physicalLocation"]["region"] == {"startLine": 5, "startColumn": 3}
+    assert results["F002"]["level"] == "error"
+    rule_ids = [r["id"] for r in run["tool"]["driver"]["rules"]]
+    assert rule_ids[results["J001"]["ruleIndex"]] == "J001"
+    assert run["tool"]["driver"]["rules"][0]["helpUri"].endswith("docs/rules.md#f001-unreadable")
+
+
+def test_github_annotations_escape_properties_and_data(cli, write_urdf):
+    path = write_urdf(NO_LIMIT, "dir,with:odd/robot.urdf")
+    result = cli("lint-urdf", str(path), "--format", "github")
+    line = next(l for l in result.stdout.splitlines() if "title=J001" in l)
+    assert line.startswith("::error file=") and "dir%2Cwith%3Aodd/robot.urdf" in line
+    assert ",line=5,col=3,title=J001::" in line
+
+
+def test_github_escape_functions():
+    from ar3cli.output_github import escape_data, escape_property
+
+    assert escape_data("50%\r\nnext") == "50%25%0D%0Anext"
+    assert escape_property("a:b,c%") == "a%3Ab%2Cc%25"
+
+
+def test_markdown_table(cli, write_urdf):
+    result = cli("lint-urdf", str(write_urdf(NO_LIMIT)), "--format", "markdown")
+    assert "| location | rule | severity | message | hint |" in result.stdout
+    assert "| J001 | error |" in result.stdout
+
+
+def test_github_format_writes_step_summary(cli, tmp_path):
+    summary = tmp_path / "step_summary.md"
+    summary.write_text("earlier step\n")
+    example = str(ASSETS / "examples" / "ar3_no_inertia.urdf")
+    result = cli("lint-urdf", example, "--format", "github", env={"GITHUB_STEP_SUMMARY": str(summary)})
+    assert result.code == 1
+    assert result.stdout.startswith("::error file=")
+    text = summary.read_text()
+    assert text.startswith("earlier step\n## ar3cli lint-urdf")  # appended, as GitHub expects
+    assert "| I001 | error |" in text
+    assert "&lt;inertial&gt;" in text and "<inertial>" not in text  # not swallowed as an HTML tag
+
+
+def test_select_and_ignore(cli, write_urdf):
+    path = str(write_urdf(NO_LIMIT))
+    ignored = json.loads(cli("lint-urdf", path, "--ignore", "J001", "--format", "json").stdout)
+    assert "J001" not in {f["rule"] for f in ignored["findings"]}
+    selected = json.loads(cli("lint-urdf", path, "--select", "I,G", "--format", "json").stdout)
+    assert {f["rule"][0] for f in selected["findings"]} <= {"I", "G"}
+    bad = cli("lint-urdf", path, "--select", "X999")
+    assert bad.code == 2 and "unknown rule code" in bad.stderr and "Traceback" not in bad.stderr
+
+
+def test_pyproject_configuration(cli, tmp_path):
+    (tmp_path / "models").mkdir()
+    (tmp_path / "models" / "a.urdf").write_text(ZERO_EFFORT)
+    (tmp_path / "models" / "b.urdf").write_text(NO_LIMIT)
+    (tmp_path / "pyproject.toml").write_text(
+        '[tool.ar3cli.lint]\nignore = ["G"]\nfail-on = "warning"\n'
+        '[tool.ar3cli.lint.per-file-ignores]\n"models/b.urdf" = ["J001"]\n'
+        '[tool.ar3cli.lint.severity]\nJ008 = "error"\n')
+    result = cli("lint-urdf", "models", "--format", "json", cwd=tmp_path)
+    doc = json.loads(result.stdout)
+    rules = {(Path(f["path"]).name, f["rule"], f["severity"]) for f in doc["findings"]}
+    assert ("a.urdf", "J008", "error") in rules
+    assert not any(name == "b.urdf" and rule == "J001" for name, rule, _ in rules)
+    assert doc["summary"]["fail_on"] == "warning" and result.code == 1
+    assert cli("lint-urdf", "models", "--no-config", "--format", "json", cwd=tmp_path).code == 1
+    (tmp_path / "pyproject.toml").write_text('[tool.ar3cli.lint]\nselekt = ["J"]\n')
+    typo = cli("lint-urdf", "models", cwd=tmp_path)
+    assert typo.code == 2 and "unknown key" in typo.stderr
+
+
+def test_inline_and_file_level_suppression(cli, write_urdf):
+    inline = NO_LIMIT.replace('<joint name="j1" type="revolute">',
+                              '<joint name="j1" type="revolute">\n<!-- ar3cli: ignore[J001] -->')
+    doc = json.loads(cli("lint-urdf", str(write_urdf(inline, "a.urdf")), "--format", "json").stdout)
+    assert "J001" not in {f["rule"] for f in doc["findings"]}
+    # a comment on an ancestor (the robot) suppresses too; ignore without a list means every rule
+    everything = NO_LIMIT.replace('<robot name="r">', '<robot name="r">\n<!-- ar3cli: ignore -->')
+    assert json.loads(cli("lint-urdf", str(write_urdf(everything, "b.urdf")), "--format", "json").stdout)["findings"] == []
+    # a comment in a sibling element does not suppress
+    sibling = NO_LIMIT.replace('<link name="base">', '<link name="base"><!-- ar3cli: ignore[J001] -->')
+    assert "J001" in {f["rule"] for f in json.loads(cli("lint-urdf", str(write_urdf(sibling, "c.urdf")),
+                                                        "--format", "json").stdout)["findings"]}
+    file_level = NO_LIMIT + "<!-- ar3cli: ignore-file[J001] -->\n"
+    assert "J001" not in {f["rule"] for f in json.loads(cli("lint-urdf", str(write_urdf(file_level, "d.urdf")),
+                                                            "--format", "json").stdout)["findings"]}
+
+
+def test_folders_are_searched_and_xacro_expanded(cli, tmp_path):
+    (tmp_path / "sub").mkdir()
+    (tmp_path / "sub" / "a.urdf").write_text(NO_LIMIT)
+    (tmp_path / "sub" / "b.urdf.xacro").write_text(
+        '<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">\n'
+        '  <xacro:arg name="effort" default="0"/>\n  <link name="base"/>\n'
+        '  <link name="arm"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial></link>\n'
+        '  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>\n'
+        '    <limit lower="-1" upper="1" effort="$(arg effort)" velocity="1"/></joint>\n</robot>\n')
+    (tmp_path / "sub" / "notes.txt").write_text("not a robot")
+    doc = json.loads(cli("lint-urdf", str(tmp_path), "--format", "json").stdout)
+    assert [Path(f["path"]).name for f in doc["files"]] == ["a.urdf", "b.urdf.xacro"]
+    j008 = [f for f in doc["findings"] if f["rule"] == "J008"]
+    assert len(j008) == 1 and j008[0]["line"] == 6  # mapped back to the joint in the xacro source
+    with_arg = json.loads(cli("lint-urdf", str(tmp_path / "sub" / "b.urdf.xacro"), "--xacro-arg", "effort:=5",
+                              "--format", "json").stdout)
+    assert with_arg["findings"] == []
+
+
+ENTITY_BOMB = ('<?xml version="1.0"?>\n<!DOCTYPE lolz [<!ENTITY lol "lol"><!ENTITY lol2 "&lol;&lol;&lol;&lol;">]>\n'
+               '<robot name="&lol2;"><link name="base"/></robot>\n')
+EXTERNAL_ENTITY = ('<?xml version="1.0"?>\n<!DOCTYPE r [<!ENTITY secret SYSTEM "file:///etc/passwd">]>\n'
+                   '<robot name="r"><link name="&secret;"/></robot>\n')
+
+
+@pytest.mark.parametrize("name,content,code", [
+    ("empty.urdf", b"", "F002"),
+    ("blank.urdf", b"   \n\n", "F002"),
+    ("binary.urdf", bytes(range(256)) * 4, "F002"),
+    ("truncated.urdf", b'<?xml version="1.0"?>\n<robot name="r">\n  <link name="base"', "F002"),
+    ("bomb.urdf", ENTITY_BOMB.encode(), "F002"),
+    ("external.urdf", EXTERNAL_ENTITY.encode(), "F002"),
+    ("sdf.urdf", b'<?xml version="1.0"?><sdf version="1.6"/>', "F003"),
+    ("broken.xacro", b'<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r"><link name="${nope}"/></robot>',
+     "F004"),
+])
+def test_bad_input_is_a_finding_and_the_run_goes_on(cli, tmp_path, name, content, code):
+    (tmp_path / name).write_bytes(content)
+    (tmp_path / "zgood.urdf").write_text(arm())
+    result = cli("lint-urdf", str(tmp_path / name), str(tmp_path / "zgood.urdf"), "--format", "json")
+    assert result.code == 1 and "Traceback" not in result.stderr, result.stderr
+    doc = json.loads(result.stdout)
+    (finding,) = [f for f in doc["findings"] if f["path"].endswith(name)]
+    assert finding["rule"] == code
+    assert "root:" not in result.stdout and "/bin/" not in result.stdout  # nothing of /etc/passwd leaked
+    assert len(doc["files"]) == 2
+
+
+def test_directory_named_like_a_file_and_missing_paths(cli, tmp_path):
+    (tmp_path / "dir.urdf").mkdir()
+    (tmp_path / "dir.urdf" / "inner.urdf").write_text(arm())
+    assert cli("lint-urdf", str(tmp_path / "dir.urdf")).code == 0
+    missing = cli("lint-urdf", str(tmp_path / "nope.urdf"))
+    assert missing.code == 2 and missing.stderr.strip().count("\n") == 0 and "no such file" in missing.stderr
+    empty = tmp_path / "empty"
+    empty.mkdir()
+    none = cli("lint-urdf", str(empty))
+    assert none.code == 2 and "no .urdf or .xacro files" in none.stderr
+
+
+def test_static_lint_does_not_import_pybullet_or_trimesh(tmp_path):
+    import subprocess
+    import sys
+
+    from tests.conftest import REPO
+
+    (tmp_path / "r.urdf").write_text(arm())
+    code = ("import sys\nfrom ar3cli.cli import main\n"
+            f"try:\n    main(['lint-urdf', {str(tmp_path / 'r.urdf')!r}])\nexcept SystemExit:\n    pass\n"
+            "print(sorted(m for m in ('pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO,
+                         env={"PYTHONPATH": str(REPO), "NO_COLOR": "1", "PATH": "/usr/bin:/bin"})
+    assert out.stdout.strip().splitlines()[-1] == "[]", out.stderr
+
+
+def test_sim_rules_run_only_with_sim(cli, write_urdf):
+    path = str(write_urdf(NO_LIMIT))
+    static = json.loads(cli("lint-urdf", path, "--format", "json").stdout)
+    assert not any(f["rule"].startswith("P") for f in static["findings"])
+    simulated = cli("lint-urdf", path, "--sim", "--format", "json")
+    doc = json.loads(simulated.stdout)  # stdout is JSON alone even though pybullet printed
+    (p001,) = [f for f in doc["findings"] if f["rule"] == "P001"]
+    assert "does not specify limits" in p001["message"]
