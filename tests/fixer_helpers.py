@@ -50,3 +50,12 @@ def only_within(old: str, new: str, ranges: list[tuple[int, int]]) -> bool:
 def write(path: Path, text: str) -> Path:
     path.write_text(text, encoding="utf-8")
     return path
+
+
+def lint_findings(cli, path: Path, select: str, *extra: str) -> list[dict]:
+    """Findings of the real ``ar3cli lint-urdf --select SELECT`` on ``path``."""
+    import json
+
+    result = cli("lint-urdf", str(path), "--select", select, "--format", "json", *extra)
+    assert result.code in (0, 1), result.stderr
+    return json.loads(result.stdout)["findings"]

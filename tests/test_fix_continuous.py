@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 from conftest import ASSETS
-from fixer_helpers import element_lines, only_within, write
+from fixer_helpers import element_lines, lint_findings, only_within, write
 
 from ar3cli.model import load_model
 
@@ -84,6 +84,7 @@ def test_to_continuous_and_missing_effort(cli, write_urdf):
 def test_fake_continuous_ar3_example(cli, tmp_path):
     source = (ASSETS / "examples" / "ar3_fake_continuous.urdf").read_text()
     path = write(tmp_path / "ar3.urdf", source)
+    assert len(lint_findings(cli, path, "J006")) == 6  # continuous-with-range, one per joint
     diff = cli("fix-continuous", str(path), "--diff")
     assert diff.code == 0 and diff.stdout.count('-    <limit lower="-100" upper="100"') == 6
     assert path.read_text() == source
@@ -94,6 +95,7 @@ def test_fake_continuous_ar3_example(cli, tmp_path):
     limit_lines = [element_lines(source, rf'<joint name="joint_{i}"', "</joint>") for i in range(1, 7)]
     assert only_within(source, fixed, limit_lines)
     assert fixed == source.replace(' lower="-100" upper="100"', "")
+    assert len(lint_findings(cli, tmp_path / "ar3.urdf", "J006")) == 0
     assert cli("fix-continuous", str(path), "--check").code == 0
 
 
@@ -121,6 +123,9 @@ def test_limits_from_moveit_yaml_on_the_real_ar3(cli, real_ar3):
     assert json.loads(result.stdout)["files"][0]["verification"]["verified"] is True
     joints = [element_lines(original, rf'name="joint_{i}"', "</joint>") for i in range(1, 7)]
     assert only_within(original, path.read_text(), [(first - 1, last) for first, last in joints])
+    before = {f["rule"] for f in lint_findings(cli, real / "urdf" / "ar3.urdf", "J", "--package-path", package)}
+    after = {f["rule"] for f in lint_findings(cli, path, "J", "--package-path", package)}
+    assert "J011" in before and not after & {"J001", "J002", "J006", "J007", "J008", "J011"}, (before, after)
     wanted = yaml.safe_load(limits_file.read_text())["joint_limits"]
     model = load_model(path, {"ar3_description": real})
     with Session() as session:
