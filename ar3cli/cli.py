@@ -17,6 +17,8 @@ from ar3cli.commands.install_check import install_check
 from ar3cli.commands.render import render_command
 from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.commands.lint_urdf import lint_urdf
+from ar3cli.commands.fix_inertia import fix_inertia
+from ar3cli.commands.fix_continuous import fix_continuous
 from ar3cli.errors import EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -49,6 +51,8 @@ app.command("render")(render_command)
 app.command("fk-verify")(fk_verify)
 app.command("lint-urdf")(lint_urdf)
 app.command("grasp-demo")(grasp_demo)
+app.command("fix-inertia")(fix_inertia)
+app.command("fix-continuous")(fix_continuous)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -1,0 +1,51 @@
+"""``ar3cli fix-continuous``: remove fake limits from continuous joints, or give them real ones."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.commands.fix_inertia import CheckOption, DiffOption, OutputOption, PathsArgument
+from ar3cli.options import FormatOption, PackagePathOption
+from ar3cli.output import OutputFormat
+
+
+def fix_continuous(
+    paths: PathsArgument,
+    limits_from: Annotated[Optional[Path], typer.Option(
+        "--limits-from", metavar="JOINT_LIMITS_YAML",
+        help="MoveIt joint_limits.yaml: joints with has_position_limits become revolute with its limits.")] = None,
+    to_continuous: Annotated[bool, typer.Option(
+        "--to-continuous", help="Revolute joints whose range covers a full turn (>= 2 pi) become continuous.")] = False,
+    effort: Annotated[Optional[float], typer.Option(
+        "--effort", help="Effort (N*m or N) to add where a fixed joint's <limit> has none.")] = None,
+    velocity: Annotated[Optional[float], typer.Option(
+        "--velocity", help="Velocity (rad/s or m/s) to add where a fixed joint's <limit> has none.")] = None,
+    verify: Annotated[bool, typer.Option(
+        "--verify/--no-verify", help="After writing, load the result in PyBullet and check the joints.")] = True,
+    diff: DiffOption = False,
+    check: CheckOption = False,
+    output: OutputOption = None,
+    package_path: PackagePathOption = None,
+    format: FormatOption = OutputFormat.text,
+) -> None:
+    """Fix continuous joints: lower/upper on a continuous joint only add a PyBullet position clamp.
+
+    Default: remove them (keep effort/velocity). --limits-from turns joints with hard stops
+    into revolute joints with the real limits. Edits only those joints, byte for byte, atomically.
+    """
+    from ar3cli.errors import UserError
+    from ar3cli.fix_continuous_plan import ContinuousOptions, make_fixer, read_joint_limits
+    from ar3cli.fix_continuous_plan import verify as verify_in_pybullet
+    from ar3cli.fixing import run_fixer
+
+    for name, value in (("--effort", effort), ("--velocity", velocity)):
+        if value is not None and not value > 0:
+            raise UserError(f"{name} {value}: must be positive")
+    limits = read_joint_limits(limits_from) if limits_from is not None else None
+    options = ContinuousOptions(limits, limits_from, to_continuous, effort, velocity)
+    code = run_fixer("fix-continuous", paths, make_fixer(options), diff=diff, check=check, output=output,
+                     fmt=format, package_path=package_path, verifier=verify_in_pybullet if verify else None)
+    raise typer.Exit(code)

@@ -1,0 +1,57 @@
+"""``ar3cli fix-inertia``: recompute bad ``<inertial>`` elements from the link geometry."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.options import FormatOption, PackagePathOption
+from ar3cli.output import OutputFormat
+
+PathsArgument = Annotated[list[Path], typer.Argument(help=".urdf files to fix (xacro is refused).", show_default=False)]
+DiffOption = Annotated[bool, typer.Option("--diff", help="Print a unified diff and write nothing.")]
+CheckOption = Annotated[bool, typer.Option("--check", help="Write nothing; exit 1 when a change is needed.")]
+OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the result to FILE instead of "
+                                                      "in place (one input only).", show_default=False)]
+
+
+def fix_inertia(
+    paths: PathsArgument,
+    links: Annotated[Optional[str], typer.Option("--links", help="Comma-separated links to recompute "
+                                                 "(default: the links the linter flags).")] = None,
+    all_links: Annotated[bool, typer.Option("--all", help="Recompute every link that has geometry.")] = False,
+    density: Annotated[Optional[float], typer.Option("--density", metavar="KG_PER_M3",
+                                                     help="Density for links without a valid mass.")] = None,
+    mass: Annotated[Optional[list[str]], typer.Option("--mass", metavar="LINK=KG",
+                                                      help="Mass of one link (repeatable); overrides the file.")] = None,
+    total_mass: Annotated[Optional[float], typer.Option("--total-mass", metavar="KG",
+                                                        help="The robot's total mass: what the known masses leave "
+                                                             "is spread over links without one, by volume.")] = None,
+    diff: DiffOption = False,
+    check: CheckOption = False,
+    output: OutputOption = None,
+    package_path: PackagePathOption = None,
+    format: FormatOption = OutputFormat.text,
+) -> None:
+    """Recompute mass, centre of mass and inertia tensor of links from their geometry.
+
+    Edits only the fixed <inertial> elements, byte for byte, and writes atomically. A link
+    without a valid mass needs --density, --mass or --total-mass: there is no default density.
+    """
+    from ar3cli.errors import UserError
+    from ar3cli.fix_inertia_plan import InertiaOptions, make_fixer, parse_masses
+    from ar3cli.fixing import run_fixer
+
+    if density is not None and not density > 0:
+        raise UserError(f"--density {density}: must be positive (kg/m^3, e.g. 1200 for PLA)")
+    if total_mass is not None and not total_mass > 0:
+        raise UserError(f"--total-mass {total_mass}: must be positive (kg)")
+    if links is not None and all_links:
+        raise UserError("--links and --all exclude each other")
+    names = [name.strip() for name in links.split(",") if name.strip()] if links is not None else None
+    options = InertiaOptions(names, all_links, density, parse_masses(mass), total_mass)
+    code = run_fixer("fix-inertia", paths, make_fixer(options), diff=diff, check=check, output=output, fmt=format,
+                     package_path=package_path)
+    raise typer.Exit(code)

@@ -1,0 +1,285 @@
+"""The fix-continuous fixer: continuous joints with fake limits, and their real limits.
+
+* Default: remove ``lower``/``upper`` from continuous joints. The URDF spec ignores them, and
+  PyBullet clamps POSITION_CONTROL targets to them (pybullet-facts.md section 3), so the popular
+  ``lower="-100" upper="100"`` adds a clamp and fixes nothing. ``effort``/``velocity`` are kept,
+  and added from ``--effort``/``--velocity`` when missing.
+* ``--limits-from joint_limits.yaml`` (MoveIt): joints with ``has_position_limits: true`` become
+  revolute with those limits (the real fix for an arm with hard stops exported as continuous);
+  velocity and effort come from the yaml when it has them, else from the file, else the options.
+* ``--to-continuous``: revolute joints whose range covers a full turn become continuous.
+
+:func:`verify` loads the written file in PyBullet and checks getJointInfo and a position target.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ar3cli.edits import Document
+from ar3cli.errors import UserError
+from ar3cli.fixing import Change, FixPlan, Skipped, number
+
+FULL_TURN = 2.0 * math.pi
+
+
+@dataclass(frozen=True)
+class YamlLimits:
+    """One joint of a MoveIt joint_limits.yaml (None where has_* is false or the value absent)."""
+
+    lower: float | None
+    upper: float | None
+    velocity: float | None
+    effort: float | None
+
+
+@dataclass
+class ContinuousOptions:
+    limits: dict[str, YamlLimits] | None = None
+    limits_path: Path | None = None
+    to_continuous: bool = False
+    effort: float | None = None
+    velocity: float | None = None
+    warnings: list[str] = field(default_factory=list)
+
+
+def read_joint_limits(path: Path) -> dict[str, YamlLimits]:
+    """Parse MoveIt's ``joint_limits.yaml`` (top key ``joint_limits``); errors are one-line UserErrors."""
+    import yaml
+
+    try:
+        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise UserError(f"{path}: no such file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserError(f"{path}: cannot read: {exc}") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
+        raise UserError(f"{where}: not valid YAML: {getattr(exc, 'problem', None) or exc}") from None
+    if not isinstance(data, dict) or not isinstance(data.get("joint_limits"), dict):
+        raise UserError(f"{path}: expected MoveIt's format with a top-level 'joint_limits:' mapping")
+    limits: dict[str, YamlLimits] = {}
+    for name, entry in data["joint_limits"].items():
+        if not isinstance(entry, dict):
+            raise UserError(f"{path}: joint_limits.{name} is not a mapping")
+        limits[str(name)] = YamlLimits(
+            _yaml_number(path, name, entry, "min_position", "has_position_limits"),
+            _yaml_number(path, name, entry, "max_position", "has_position_limits"),
+            _yaml_number(path, name, entry, "max_velocity", "has_velocity_limits"),
+            _yaml_number(path, name, entry, "max_effort", "has_effort_limits"))
+    return limits
+
+
+def _yaml_number(path: Path, joint: str, entry: dict, key: str, flag: str) -> float | None:
+    if entry.get(flag) is not True or key not in entry:
+        return None
+    value = entry[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise UserError(f"{path}: joint_limits.{joint}.{key} is {value!r}, expected a number")
+    return float(value)
+
+
+def make_fixer(options: ContinuousOptions):
+    def fix(model, document: Document) -> FixPlan:
+        return plan_continuous(model, document, options)
+
+    return fix
+
+
+def plan_continuous(model, document: Document, options: ContinuousOptions) -> FixPlan:
+    plan = FixPlan(context={"joints": {}})
+    limits = options.limits or {}
+    for name in limits:
+        if model.joint(name) is None:
+            plan.notes.append(f"warning: {options.limits_path}: joint {name!r} is not in {model.path}")
+    for joint in model.joints:
+        entry = limits.get(joint.name)
+        if entry is not None and entry.lower is not None and entry.upper is not None:
+            _to_revolute(document, plan, joint, entry, options)
+        elif joint.type == "continuous":
+            _remove_fake_limits(document, plan, joint, options)
+        elif options.to_continuous and joint.type == "revolute":
+            _full_turn_to_continuous(document, plan, joint)
+    return plan
+
+
+def _element(joint) -> str:
+    return f"joint {joint.name}"
+
+
+def _record(plan: FixPlan, joint, **values) -> None:
+    plan.context["joints"].setdefault(joint.name, {}).update(values)
+
+
+def _remove_fake_limits(document: Document, plan: FixPlan, joint, options: ContinuousOptions) -> None:
+    limit = joint.element.find("limit")
+    if limit is None or (limit.get("lower") is None and limit.get("upper") is None):
+        return
+    span = document.span(limit)
+    line = limit.sourceline or joint.line
+    for key in ("lower", "upper"):
+        if limit.get(key) is not None:
+            document.remove_attribute(span, key)
+            plan.changes.append(Change(_element(joint), line, f"limit {key}", limit.get(key), None,
+                                       "ignored by the URDF spec; pybullet only clamps position targets to it"))
+    _ensure_effort_velocity(document, plan, joint, limit, {}, options, required=False)
+    _record(plan, joint, expect="continuous", old_upper=joint.limit.upper if joint.limit else None)
+
+
+def _ensure_effort_velocity(document: Document, plan: FixPlan, joint, limit, from_yaml: dict[str, float | None],
+                            options: ContinuousOptions, required: bool) -> bool:
+    """Set effort/velocity: yaml value, else a valid file value, else the option. False if one is missing."""
+    span = document.span(limit) if limit is not None else None
+    complete = True
+    for key, option in (("effort", options.effort), ("velocity", options.velocity)):
+        old = limit.get(key) if limit is not None else None
+        yaml_value = from_yaml.get(key)
+        if yaml_value is not None:
+            new, source = number(yaml_value), options.limits_path.name
+        elif old is not None:
+            continue
+        elif option is not None:
+            new, source = number(option), f"--{key} (added: the joint had none)"
+        else:
+            if required:
+                complete = False
+            else:
+                plan.notes.append(f"note: joint {joint.name} has no {key}; pybullet reads 0 for it. "
+                                  f"Pass --{key} to add one")
+            continue
+        if old is not None and _same(old, new):
+            continue
+        if span is not None:
+            document.set_attribute(span, key, new)
+        plan.changes.append(Change(_element(joint), (limit.sourceline if limit is not None else joint.line) or 0,
+                                   f"limit {key}", old, new, source))
+    return complete
+
+
+def _same(old: str | None, new: str) -> bool:
+    try:
+        return old is not None and math.isclose(float(old), float(new), rel_tol=1e-12, abs_tol=0.0)
+    except ValueError:
+        return False
+
+
+def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, options: ContinuousOptions) -> None:
+    source = options.limits_path.name if options.limits_path else "joint_limits.yaml"
+    if joint.type not in ("continuous", "revolute", "prismatic"):
+        plan.notes.append(f"warning: {source}: joint {joint.name} is {joint.type!r}; position limits ignored")
+        return
+    new_type = "prismatic" if joint.type == "prismatic" else "revolute"
+    limit = joint.element.find("limit")
+    values = {"lower": number(entry.lower), "upper": number(entry.upper)}
+    yaml_extra = {"effort": entry.effort, "velocity": entry.velocity}
+    # effort/velocity: yaml, else a file value, else the option; a revolute joint needs both
+    for key in ("effort", "velocity"):
+        old = limit.get(key) if limit is not None else None
+        option = options.effort if key == "effort" else options.velocity
+        if entry_value := yaml_extra[key]:
+            values[key] = number(entry_value)
+        elif old is not None:
+            values[key] = old
+        elif option is not None:
+            values[key] = number(option)
+        else:
+            plan.skipped.append(Skipped(_element(joint), joint.line,
+                                        f"becomes {new_type} but has no {key} in the file or {source}: "
+                                        f"pass --{key}"))
+            return
+    if joint.type != new_type:
+        document.set_attribute(document.span(joint.element), "type", new_type)
+        plan.changes.append(Change(_element(joint), joint.line, "type", joint.type, new_type,
+                                   f"{source}: has_position_limits"))
+    if limit is None:
+        q = document.quote.decode()
+        text = "<limit " + " ".join(f"{k}={q}{values[k]}{q}" for k in ("lower", "upper", "effort", "velocity")) + "/>"
+        document.insert_child(document.span(joint.element), [text])
+        for key in ("lower", "upper", "effort", "velocity"):
+            origin = source if key in ("lower", "upper") or yaml_extra.get(key) else f"--{key} (added)"
+            plan.changes.append(Change(_element(joint), joint.line, f"limit {key}", None, values[key], origin))
+    else:
+        span = document.span(limit)
+        for key in ("lower", "upper", "effort", "velocity"):
+            old = limit.get(key)
+            if old is not None and (_same(old, values[key]) or old == values[key]):
+                continue
+            document.set_attribute(span, key, values[key])
+            origin = source if key in ("lower", "upper") or yaml_extra.get(key) else f"--{key} (added)"
+            plan.changes.append(Change(_element(joint), limit.sourceline or joint.line, f"limit {key}", old,
+                                       values[key], origin))
+    _record(plan, joint, expect=new_type, lower=entry.lower, upper=entry.upper)
+
+
+def _full_turn_to_continuous(document: Document, plan: FixPlan, joint) -> None:
+    limit = joint.limit
+    if limit is None or limit.lower is None or limit.upper is None or limit.upper - limit.lower < FULL_TURN - 1e-9:
+        return
+    document.set_attribute(document.span(joint.element), "type", "continuous")
+    reason = f"range {limit.upper - limit.lower:.4g} rad covers a full turn (--to-continuous)"
+    plan.changes.append(Change(_element(joint), joint.line, "type", "revolute", "continuous", reason))
+    span = document.span(limit.element)
+    for key in ("lower", "upper"):
+        document.remove_attribute(span, key)
+        plan.changes.append(Change(_element(joint), limit.element.sourceline or joint.line, f"limit {key}",
+                                   limit.element.get(key), None, reason))
+    _record(plan, joint, expect="continuous", old_upper=limit.upper)
+
+
+# ---- verification in PyBullet -----------------------------------------------------------------
+def verify(model, plan: FixPlan) -> dict:
+    """Load the fixed file in PyBullet; check each changed joint's limits (and that a target
+    beyond a removed fake limit is reached)."""
+    from ar3cli.sim import Session
+
+    checks = []
+    joints = plan.context.get("joints", {})
+    if not joints:
+        return {"verified": True, "checks": []}
+    try:
+        with Session() as session:
+            body = session.load(model)
+            p = session.p
+            records = {record.name: record for record in body.joints}
+            for name, expected in joints.items():
+                record = records.get(name)
+                if record is None:
+                    checks.append(_check(name, "loaded", False, "joint not found in pybullet"))
+                    continue
+                info = p.getJointInfo(body.id, record.index, physicsClientId=session.client)
+                lower, upper = info[8], info[9]
+                if expected["expect"] == "continuous":
+                    checks.append(_check(name, "no position limit", lower > upper,
+                                         f"getJointInfo lower={lower:g} upper={upper:g}"))
+                    old_upper = expected.get("old_upper")
+                    if old_upper is not None and old_upper < FULL_TURN:
+                        target = old_upper + 0.5
+                        reached = _drive(session, body, record.index, target)
+                        checks.append(_check(name, "target beyond old limit", abs(reached - target) < 1e-2,
+                                             f"target {target:.4g} rad, reached {reached:.4g} rad "
+                                             f"(old upper {old_upper:g})"))
+                else:
+                    ok = math.isclose(lower, expected["lower"], abs_tol=1e-9) and math.isclose(
+                        upper, expected["upper"], abs_tol=1e-9)
+                    checks.append(_check(name, f"{expected['expect']} limits", ok,
+                                         f"getJointInfo lower={lower:.9g} upper={upper:.9g}"))
+    except UserError as exc:
+        return {"verified": False, "checks": [], "error": exc.message}
+    return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+
+
+def _check(joint: str, check: str, ok: bool, detail: str) -> dict:
+    return {"joint": joint, "check": check, "status": "ok" if ok else "fail", "detail": detail}
+
+
+def _drive(session, body, index: int, target: float, steps: int = 2400) -> float:
+    """POSITION_CONTROL one joint to ``target`` (others held by pybullet's default motors)."""
+    p = session.p
+    p.setJointMotorControl2(body.id, index, p.POSITION_CONTROL, targetPosition=target, force=1000.0,
+                            physicsClientId=session.client)
+    for _ in range(steps):
+        p.stepSimulation(physicsClientId=session.client)
+    return float(p.getJointState(body.id, index, physicsClientId=session.client)[0])

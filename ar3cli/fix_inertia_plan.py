@@ -1,0 +1,262 @@
+"""The fix-inertia fixer: choose links, pick each link's mass source, write new ``<inertial>``s.
+
+Mass source, always explicit (first that applies): ``--mass LINK=KG``; a valid (finite, > 0)
+mass already in the file; ``--density``; ``--total-mass`` (the robot's total: the masses kept
+above are subtracted and the rest is spread over the remaining links in proportion to their
+geometry volume). A link without any of these is reported and left alone.
+
+The centre of mass and tensor always come from the geometry (collision, else visual): the
+tensor is only right about the COM it was computed about. Frame links (no geometry, fixed
+joint) get ``FRAME_LINK_MASS`` / ``FRAME_LINK_INERTIA``; docs/commands/fix-inertia.md has the
+PyBullet measurement behind that choice.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ar3cli import inertia
+from ar3cli import mass_properties as mp
+from ar3cli.edits import Document
+from ar3cli.errors import UserError
+from ar3cli.fixing import Change, FixPlan, Skipped, number
+
+TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+
+
+@dataclass
+class InertiaOptions:
+    links: list[str] | None = None
+    all_links: bool = False
+    density: float | None = None
+    masses: dict[str, float] = field(default_factory=dict)
+    total_mass: float | None = None
+
+
+@dataclass
+class _Target:
+    link: object
+    reason: str
+    geometry: inertia.GeometryMass | None = None
+    mass: float | None = None
+    mass_source: str = ""
+
+
+def parse_masses(values: list[str] | None) -> dict[str, float]:
+    """``LINK=KG`` pairs; malformed ones raise UserError."""
+    masses: dict[str, float] = {}
+    for value in values or []:
+        name, sep, kg = value.partition("=")
+        try:
+            mass = float(kg)
+        except ValueError:
+            mass = float("nan")
+        if not sep or not name or not (math.isfinite(mass) and mass > 0):
+            raise UserError(f"--mass {value!r}: expected LINK=KG with a positive mass, e.g. --mass link_4=0.35")
+        masses[name] = mass
+    return masses
+
+
+def make_fixer(options: InertiaOptions):
+    """The fixer function for :func:`ar3cli.fixing.run_fixer`."""
+
+    def fix(model, document: Document) -> FixPlan:
+        return plan_inertia(model, document, options)
+
+    return fix
+
+
+def _select(model, options: InertiaOptions, cache: dict) -> dict[str, str]:
+    for name in [*(options.links or []), *options.masses]:
+        if model.link(name) is None:
+            raise UserError(f"{model.path}: no link named {name!r}")
+    if options.all_links:
+        return {link.name: "--all" for link in model.links}
+    if options.links:
+        return {name: "--links" for name in options.links}
+    return inertia.links_needing_inertia(model, cache)
+
+
+def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
+    plan = FixPlan()
+    cache: dict = {}
+    selected = _select(model, options, cache)
+    targets: list[_Target] = []
+    for name, reason in selected.items():
+        link = model.link(name)
+        target = _Target(link, reason)
+        if not link.has_geometry:
+            if inertia.is_frame_link(model, link) and name not in options.masses:
+                _write_frame_link(document, plan, link, reason)
+            elif options.all_links and link.inertial is None:
+                continue  # e.g. a geometry-less root: nothing to compute, nothing wrong
+            else:
+                plan.skipped.append(Skipped(_element(link), link.line,
+                                            f"{reason}; no geometry to compute the inertia from"))
+            continue
+        try:
+            target.geometry = inertia.geometry_mass(link, cache)
+        except inertia.GeometryError as exc:
+            plan.skipped.append(Skipped(_element(link), link.line, f"{reason}; {exc}"))
+            continue
+        targets.append(target)
+    _assign_masses(model, targets, options, plan)
+    for target in targets:
+        if target.mass is None:
+            plan.skipped.append(Skipped(_element(target.link), target.link.line,
+                                        f"{target.reason}; no valid mass in the file: give --density, "
+                                        f"--mass {target.link.name}=KG or --total-mass"))
+            continue
+        props = mp.scaled_to_mass(target.geometry.props, target.mass)
+        geometry_source = f"{target.geometry.role}: " + "; ".join(target.geometry.sources)
+        _write_inertial(document, plan, target.link, props, target.mass_source, geometry_source)
+    plan.changes.sort(key=lambda change: change.line)
+    plan.skipped.sort(key=lambda skipped: skipped.line)
+    return plan
+
+
+def _valid_file_mass(link) -> float | None:
+    mass = link.inertial.mass if link.inertial is not None else None
+    return mass if mass is not None and math.isfinite(mass) and mass > 0 else None
+
+
+def _assign_masses(model, targets: list[_Target], options: InertiaOptions, plan: FixPlan) -> None:
+    pending: list[_Target] = []
+    for target in targets:
+        name = target.link.name
+        file_mass = _valid_file_mass(target.link)
+        if name in options.masses:
+            target.mass, target.mass_source = options.masses[name], f"--mass {name}={number(options.masses[name])}"
+        elif file_mass is not None:
+            target.mass, target.mass_source = file_mass, "mass kept from file"
+        elif options.density is not None:
+            target.mass = options.density * target.geometry.volume
+            target.mass_source = (f"density {number(options.density)} kg/m3 x volume "
+                                  f"{target.geometry.volume:.4g} m3")
+        else:
+            pending.append(target)
+    if options.total_mass is None or not pending:
+        return
+    pending_names = {t.link.name for t in pending}
+    known = sum(t.mass for t in targets if t.mass is not None)
+    known += sum(_valid_file_mass(link) or 0.0 for link in model.links
+                 if link.name not in pending_names and link.name not in {t.link.name for t in targets})
+    remainder = options.total_mass - known
+    volume = sum(t.geometry.volume for t in pending)
+    if not remainder > 0:
+        raise UserError(f"--total-mass {number(options.total_mass)} kg: the other links already weigh "
+                        f"{known:.4g} kg, nothing is left for {', '.join(sorted(pending_names))}")
+    for target in pending:
+        share = target.geometry.volume / volume
+        target.mass = remainder * share
+        target.mass_source = (f"--total-mass {number(options.total_mass)} kg: {remainder:.4g} kg left after the "
+                              f"known masses, spread by volume ({share:.1%})")
+    plan.notes.append(f"--total-mass: {known:.4g} kg in links with known masses, {remainder:.4g} kg spread over "
+                      f"{len(pending)} link(s) by volume")
+
+
+def _element(link) -> str:
+    return f"link {link.name} <inertial>"
+
+
+def _write_frame_link(document: Document, plan: FixPlan, link, reason: str) -> None:
+    props = mp.MassProperties(inertia.FRAME_LINK_MASS, np.zeros(3), np.eye(3) * inertia.FRAME_LINK_INERTIA)
+    source = "frame link (no geometry, fixed joint): tiny inertial, see docs/commands/fix-inertia.md"
+    _write_inertial(document, plan, link, props, source, source)
+
+
+def _write_inertial(document: Document, plan: FixPlan, link, props: mp.MassProperties,
+                    mass_source: str, geometry_source: str) -> None:
+    """Queue the edits that make ``link``'s ``<inertial>`` say ``props`` (only fields that differ)."""
+    xyz = " ".join(number(v) for v in _clean(props.com, absolute=1e-12))
+    tensor = _clean(props.inertia, relative=1e-10)
+    values = dict(zip(TENSOR_KEYS, (tensor[0, 0], tensor[0, 1], tensor[0, 2], tensor[1, 1], tensor[1, 2],
+                                    tensor[2, 2])))
+    new_tensor = {k: number(v) for k, v in values.items()}
+    element = _element(link)
+    if link.inertial is None:
+        q = document.quote.decode()
+        lines = ["<inertial>",
+                 f"  <origin xyz={q}{xyz}{q} rpy={q}0 0 0{q}/>",
+                 f"  <mass value={q}{number(props.mass)}{q}/>",
+                 "  <inertia " + " ".join(f"{k}={q}{v}{q}" for k, v in new_tensor.items()) + "/>",
+                 "</inertial>"]
+        document.insert_child(document.span(link.element), lines)
+        plan.changes.append(Change(element, link.line, "origin xyz", None, xyz, geometry_source))
+        plan.changes.append(Change(element, link.line, "mass", None, number(props.mass), mass_source))
+        plan.changes.append(Change(element, link.line, "inertia", None, _tensor_text(new_tensor), geometry_source))
+        return
+    inertial_element = link.inertial.element
+    inertial_span = document.span(inertial_element)
+    line = inertial_element.sourceline or link.line
+    origin = inertial_element.find("origin")
+    if origin is None:
+        if not _same_numbers("0 0 0", xyz):  # an absent <origin> already says 0 0 0
+            q = document.quote.decode()
+            first = document.span(inertial_element).children
+            document.insert_child(inertial_span, [f"<origin xyz={q}{xyz}{q} rpy={q}0 0 0{q}/>"],
+                                  before=first[0] if first else None)
+            plan.changes.append(Change(element, line, "origin xyz", None, xyz, geometry_source))
+    else:
+        _set(document, plan, origin, "xyz", xyz, element, geometry_source, same=_same_numbers)
+        _set(document, plan, origin, "rpy", "0 0 0", element, "tensor written in the link frame",
+             same=_same_numbers, default="0 0 0")
+    mass = inertial_element.find("mass")
+    if mass is None:
+        document.insert_child(inertial_span, [f"<mass {document.format_attr('value', number(props.mass)).decode()}/>"])
+        plan.changes.append(Change(element, line, "mass", None, number(props.mass), mass_source))
+    else:
+        _set(document, plan, mass, "value", number(props.mass), element, mass_source, same=_same_numbers)
+    tensor_element = inertial_element.find("inertia")
+    if tensor_element is None:
+        document.insert_child(inertial_span, ["<inertia " + " ".join(
+            document.format_attr(k, v).decode() for k, v in new_tensor.items()) + "/>"])
+        plan.changes.append(Change(element, line, "inertia", None, _tensor_text(new_tensor), geometry_source))
+        return
+    old = {k: tensor_element.get(k) for k in TENSOR_KEYS}
+    if all(_same_numbers(old[k], v) for k, v in new_tensor.items()):
+        return
+    span = document.span(tensor_element)
+    for key, value in new_tensor.items():
+        if not _same_numbers(old[key], value):
+            document.set_attribute(span, key, value)
+    plan.changes.append(Change(element, tensor_element.sourceline or line, "inertia",
+                               _tensor_text(old), _tensor_text(new_tensor), geometry_source))
+
+
+def _set(document: Document, plan: FixPlan, element, attribute: str, value: str, name: str, source: str,
+         same, default: str | None = None) -> None:
+    old = element.get(attribute)
+    if same(old if old is not None else default, value):
+        return
+    document.set_attribute(document.span(element), attribute, value)
+    label = f"{element.tag} {attribute}" if element.tag != "mass" else "mass"
+    plan.changes.append(Change(name, element.sourceline or 0, label, old, value, source))
+
+
+def _same_numbers(old: str | None, new: str) -> bool:
+    """True when the old text already says the new numbers (so nothing is rewritten)."""
+    if old is None:
+        return False
+    try:
+        a = [float(x) for x in old.split()]
+        b = [float(x) for x in new.split()]
+    except ValueError:
+        return False
+    return len(a) == len(b) and all(math.isclose(x, y, rel_tol=1e-9, abs_tol=1e-15) for x, y in zip(a, b))
+
+
+def _clean(values: np.ndarray, relative: float = 0.0, absolute: float = 0.0) -> np.ndarray:
+    """Zero out rounding noise: entries below ``absolute`` or ``relative`` x the largest entry
+    (rotating a diagonal tensor by rpy angles leaves ~1e-17 off-diagonal residue)."""
+    array = np.array(values, dtype=float)
+    scale = float(np.max(np.abs(array))) if array.size else 0.0
+    array[np.abs(array) < max(absolute, relative * scale)] = 0.0
+    return array
+
+
+def _tensor_text(values: dict[str, str | None]) -> str:
+    return " ".join(f"{k}={values.get(k)}" for k in TENSOR_KEYS)

@@ -1,0 +1,200 @@
+"""The plumbing shared by every fixer: load, plan edits, diff / check / write, report.
+
+A fixer is a function ``(model, document) -> FixPlan`` that queues byte splices on the
+:class:`~ar3cli.edits.Document` and records a :class:`Change` for each field it changes (with
+old value, new value and where the new number came from) and a :class:`Skipped` for each element
+it could not fix. :func:`run_fixer` does everything else the same way for all fixers: refuses
+xacro, builds the new bytes, checks they still parse, prints a diff (``--diff``), reports
+(``--check``), or writes atomically in place or to ``-o``, optionally verifies the written file
+(in PyBullet for fix-continuous), and renders one table or one JSON document.
+"""
+
+from __future__ import annotations
+
+import difflib
+import sys
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ar3cli.edits import Document, atomic_write
+from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
+from ar3cli.output import OutputFormat, Report, Table, console, render, render_table
+
+
+@dataclass
+class Change:
+    """One changed field of one element."""
+
+    element: str
+    line: int
+    field: str
+    old: str | None
+    new: str | None
+    source: str
+
+
+@dataclass
+class Skipped:
+    """An element that needed a fix but could not get one, and why."""
+
+    element: str
+    line: int
+    reason: str
+
+
+@dataclass
+class FixPlan:
+    """What a fixer did to one document; ``context`` is private data for its verify step."""
+
+    changes: list[Change] = field(default_factory=list)
+    skipped: list[Skipped] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    context: dict[str, Any] = field(default_factory=dict)
+
+
+Fixer = Callable[[Any, Document], FixPlan]
+Verifier = Callable[[Any, FixPlan], dict[str, Any]]
+
+
+@dataclass
+class FileResult:
+    path: Path
+    plan: FixPlan
+    changed: bool
+    written: Path | None = None
+    diff: str = ""
+    verification: dict[str, Any] | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        data = {"path": str(self.path), "changed": self.changed,
+                "written": str(self.written) if self.written else None,
+                "changes": [asdict(c) for c in self.plan.changes],
+                "skipped": [asdict(s) for s in self.plan.skipped], "notes": self.plan.notes}
+        if self.verification is not None:
+            data["verification"] = self.verification
+        if self.diff:
+            data["diff"] = self.diff
+        return data
+
+
+def number(value: float) -> str:
+    """A float as URDF text: exactly as typed when it is short (a yaml limit, a --mass), else 10
+    significant digits (a computed number; far below any physical tolerance)."""
+    if value == 0:
+        return "0"
+    text = repr(float(value))
+    digits = text.lower().split("e")[0].replace("-", "").replace(".", "").strip("0")
+    if len(digits) > 12:
+        text = f"{value:.10g}"
+    elif text.endswith(".0"):
+        text = text[:-2]
+    return "0" if text in ("-0", "0") else text
+
+
+def refuse_xacro(paths: list[Path]) -> None:
+    for path in paths:
+        if path.name.endswith(".xacro"):
+            raise UserError(f"{path}: is a xacro file; fixing the generated URDF would not fix the source. "
+                            "Fix the .xacro by hand (the expanded-URDF output of this command with --diff shows "
+                            "what to change), or run this command on a URDF")
+
+
+def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, check: bool, output: Path | None,
+              fmt: OutputFormat, package_path: list[str] | None, verifier: Verifier | None = None) -> int:
+    """Run ``fixer`` on every path and report; returns the exit code."""
+    from ar3cli.options import load_from_options
+
+    if not paths:
+        raise UserError("give at least one file")
+    if output is not None and len(paths) != 1:
+        raise UserError("-o/--output takes exactly one input file")
+    refuse_xacro(paths)
+    results: list[FileResult] = []
+    for path in paths:
+        model = load_from_options(path, package_path, None)
+        document = Document(model.source_bytes)
+        document.bind(model.root)
+        plan = fixer(model, document)
+        new = document.apply()
+        result = FileResult(path, plan, changed=new != model.source_bytes)
+        if result.changed:
+            _check_parses(path, new)
+        if diff and result.changed:
+            result.diff = unified_diff(path, model.source_bytes, new)
+        target = output or path
+        if not diff and not check and (result.changed or output is not None):
+            def validate(temp: Path, result: FileResult = result) -> None:
+                new_model = load_from_options(temp, package_path, None)
+                if verifier is not None and result.plan.changes:
+                    result.verification = verifier(new_model, result.plan)
+
+            atomic_write(target, new, validate)
+            result.written = target
+        results.append(result)
+    return _report(command, results, diff=diff, check=check, fmt=fmt)
+
+
+def _check_parses(path: Path, data: bytes) -> None:
+    from ar3cli import xmlsource
+
+    normalized, _ = xmlsource.normalize(data)
+    xmlsource.parse(normalized, path)  # raises UserError (a fixer bug) rather than writing junk
+
+
+def unified_diff(path: Path, old: bytes, new: bytes) -> str:
+    from ar3cli.xmlsource import decode_text
+
+    return "".join(difflib.unified_diff(decode_text(old).splitlines(keepends=True),
+                                        decode_text(new).splitlines(keepends=True),
+                                        fromfile=f"a/{path}", tofile=f"b/{path}"))
+
+
+def _report(command: str, results: list[FileResult], *, diff: bool, check: bool, fmt: OutputFormat) -> int:
+    needs_change = any(r.changed for r in results)
+    skipped = any(r.plan.skipped for r in results)
+    failed_verify = any(r.verification and not r.verification.get("verified", True) for r in results)
+    mode = "diff" if diff else "check" if check else "write"
+    code = EXIT_PROBLEMS if skipped or failed_verify or (check and needs_change) else EXIT_OK
+    data = {"command": command, "mode": mode, "ok": code == EXIT_OK,
+            "files": [r.to_dict() for r in results]}
+    rows, skipped_rows, verify_rows = [], [], []
+    for r in results:
+        for c in r.plan.changes:
+            rows.append([str(r.path), c.element, c.line, c.field, c.old, c.new, c.source])
+        for s in r.plan.skipped:
+            skipped_rows.append([str(r.path), s.element, s.line, s.reason])
+        for check_row in (r.verification or {}).get("checks", []):
+            verify_rows.append([str(r.path), check_row["joint"], check_row["check"], check_row["status"],
+                                check_row["detail"]])
+    verb = {"diff": "would change", "check": "would change", "write": "changed"}[mode]
+    tables = [Table(f"ar3cli {command}: {verb}", ["file", "element", "line", "field", "old", "new", "source"], rows)]
+    if skipped_rows:
+        tables.append(Table("not fixed", ["file", "element", "line", "reason"], skipped_rows))
+    if verify_rows:
+        tables.append(Table("verified in PyBullet", ["file", "joint", "check", "status", "detail"], verify_rows,
+                            status_column="status"))
+    if len(results) == 1:  # the file is in the summary line; keep the table narrow
+        for table in tables:
+            table.columns, table.rows = table.columns[1:], [row[1:] for row in table.rows]
+    lines = [note for r in results for note in r.plan.notes]
+    for r in results:
+        if not r.changed:
+            lines.append(f"{r.path}: nothing to change")
+        elif r.written:
+            lines.append(f"{r.path}: {len(r.plan.changes)} field(s) changed, written to {r.written}")
+        else:
+            lines.append(f"{r.path}: {len(r.plan.changes)} field(s) would change")
+    if OutputFormat(fmt) is OutputFormat.text and diff:
+        sys.stdout.write("".join(r.diff for r in results))
+        sys.stdout.flush()
+        err = console(stderr=True)
+        for table in tables:
+            if table.rows:
+                render_table(table, err)
+        for line in lines:
+            err.print(line, markup=False)
+        return code
+    render(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK), fmt)
+    return code
