@@ -196,7 +196,7 @@ def links_needing_inertia(model: Model, cache: dict | None = None) -> dict[str, 
     so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
     ``cache`` is accepted for callers that share a mesh cache; the rules keep their own.
     """
-    from ar3cli.lint import Context, LintOptions, _suppressed_inline
+    from ar3cli.lint import Context, LintOptions, suppressed_inline
     from ar3cli.rules.inertia import RULES
 
     context = Context(model, LintOptions())
@@ -205,7 +205,7 @@ def links_needing_inertia(model: Model, cache: dict | None = None) -> dict[str, 
         for rule in RULES:
             for hit in rule.check(context):
                 element = _owning_link(hit.element)
-                if element is None or _suppressed_inline(hit.element, rule.code):
+                if element is None or suppressed_inline(hit.element, rule.code):
                     continue
                 found.setdefault(element.get("name", ""), f"{rule.code} {rule.name}: {hit.message}")
     finally:

@@ -150,7 +150,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions) -> FileResult
             for hit in rule.check(context):
                 if matches(rule.code, file_ignores) or _file_ignored(shown, rule.code, options):
                     continue
-                if hit.element is not None and _suppressed_inline(hit.element, rule.code):
+                if hit.element is not None and suppressed_inline(hit.element, rule.code):
                     continue
                 line, column = locator.locate(hit)
                 findings.append(_override(Finding(rule.code, rule.severity, hit.message, shown, line, column,
@@ -244,7 +244,7 @@ def _codes(text: str | None) -> list[str]:
     return [code.strip().upper() for code in text.split(",") if code.strip()] or ["ALL"]
 
 
-def _suppressed_inline(element, code: str) -> bool:
+def suppressed_inline(element, code: str) -> bool:
     """True when the element or an ancestor holds a ``<!-- ar3cli: ignore[...] -->`` child comment."""
     from lxml import etree
 

