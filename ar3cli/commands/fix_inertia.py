@@ -37,7 +37,7 @@ def fix_inertia(
 ) -> None:
     """Recompute mass, centre of mass and inertia tensor of links from their geometry.
 
-    Edits only the fixed <inertial> elements, byte for byte, and writes atomically. A link
+    Edits only the fixed `<inertial>` elements, byte for byte, and writes atomically. A link
     without a valid mass needs --density, --mass or --total-mass: there is no default density.
     """
     from ar3cli.errors import UserError
