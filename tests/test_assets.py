@@ -23,7 +23,7 @@ from lxml import etree
 
 from ar3cli import mass_properties as mp
 from ar3cli.capture import capture_fds
-from tests.conftest import ASSETS, SHARED
+from tests.conftest import ASSETS, REPO, SHARED
 
 AR3 = ASSETS / "ar3" / "ar3.urdf"
 AR3_XACRO = ASSETS / "ar3" / "ar3.urdf.xacro"
@@ -350,9 +350,11 @@ def test_examples_show_their_mistake_in_pybullet(pb: int) -> None:
 
 
 def test_real_description_is_not_copied_into_the_repo() -> None:
-    """Only numbers from the real AR3 may be used, never its files (checked under assets/)."""
-    for path in ASSETS.rglob("*"):
-        if not path.is_file():
-            continue
-        assert not path.name.lower().endswith(".stl")
-        assert path.name not in {"joint_limits.yaml", "ar3_gazebo.urdf.xacro"}
+    """Only numbers from the real AR3 may be used, never its files (checked anywhere in the repo)."""
+    real_files = {path.read_bytes() for path in REAL.rglob("*") if path.is_file()} if REAL.is_dir() else set()
+    tracked = [path for path in REPO.rglob("*")
+               if path.is_file() and ".git" not in path.parts and ".venv" not in path.parts]
+    for path in tracked:
+        assert not path.name.lower().endswith(".stl"), path
+        if real_files and path.stat().st_size < 2_000_000:
+            assert path.read_bytes() not in real_files, f"{path} is a copy of a file from the real AR3 description"
