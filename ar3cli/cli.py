@@ -13,6 +13,7 @@ import typer
 
 from ar3cli import __version__
 from ar3cli.commands.install_check import install_check
+from ar3cli.commands.sample_collisions import sample_collisions
 from ar3cli.errors import EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -41,6 +42,7 @@ def _root(
 
 
 app.command("install-check")(install_check)
+app.command("sample-collisions")(sample_collisions)
 
 
 def main(argv: list[str] | None = None) -> None:
