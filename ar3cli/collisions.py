@@ -192,28 +192,15 @@ class Checker:
 
 
 # ---- parallel counting ----------------------------------------------------------------------------
-_worker_checker: Checker | None = None
-_worker_error: Exception | None = None
+# The parent and J-1 child processes pull chunks from a shared counter until none is left, so a
+# process that starts late or runs slowly simply takes fewer chunks; every chunk's counts depend
+# only on its configurations, so the sums are exact and identical for any J.
+_inherited_checker: Checker | None = None
+_DONE = "done"
 
 
-def _worker_init(source: ModelSource) -> None:
-    """Load the model once per worker. A failure is kept and re-raised by the first task: an
-    exception escaping a Pool initializer would make the pool restart workers forever."""
-    global _worker_checker, _worker_error
-    try:
-        _worker_checker = Checker(source.load())
-    except Exception as exc:  # noqa: BLE001 - re-raised in the parent through the first task
-        _worker_error = exc
-
-
-def _worker_count(chunk: np.ndarray) -> tuple[int, np.ndarray]:
-    if _worker_checker is None:
-        raise _worker_error or UserError("collision worker did not start")
-    return len(chunk), _worker_checker.count(chunk)
-
-
-def chunk_bounds(total: int, jobs: int, per_job: int = 4, minimum: int = 250) -> list[tuple[int, int]]:
-    """Contiguous [start, stop) chunks: about ``per_job`` per job (for progress), none tiny."""
+def chunk_bounds(total: int, jobs: int, per_job: int = 8, minimum: int = 100) -> list[tuple[int, int]]:
+    """Contiguous [start, stop) chunks: about ``per_job`` per job (balance, progress), none tiny."""
     if total <= 0:
         return []
     count = max(1, min(jobs * per_job, math.ceil(total / minimum)))
@@ -229,6 +216,26 @@ def start_method() -> str:
     return "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
 
 
+def _claim(next_chunk, chunks) -> tuple[int, int] | None:
+    with next_chunk.get_lock():
+        index = next_chunk.value
+        next_chunk.value += 1
+    return chunks[index] if index < len(chunks) else None
+
+
+def _child(source: ModelSource | None, configs: np.ndarray, chunks, next_chunk, results) -> None:
+    """A worker process: count chunks until none is left, then say so (errors travel as messages)."""
+    try:
+        checker = _inherited_checker if source is None else Checker(source.load())
+        assert checker is not None
+        while (chunk := _claim(next_chunk, chunks)) is not None:
+            results.put((chunk[1] - chunk[0], checker.count(configs[chunk[0]:chunk[1]])))
+    except BaseException as exc:  # noqa: BLE001 - reported by the parent as a one-line error
+        results.put(("error", str(exc)))
+    finally:
+        results.put(_DONE)
+
+
 def count_collisions(
     checker: Checker,
     source: ModelSource,
@@ -237,44 +244,55 @@ def count_collisions(
     progress: Callable[[int], None] | None = None,
     method: str | None = None,
 ) -> np.ndarray:
-    """Per-pair collision counts over ``configs``: in ``checker`` for one job, else in ``jobs``
-    worker processes (one PyBullet client each). Counts are summed, so exact for any ``jobs``.
+    """Per-pair collision counts over ``configs`` (rows), in ``checker`` plus ``jobs - 1`` worker
+    processes (one PyBullet client each); exact and independent of ``jobs``.
 
-    ``progress(n)`` is called with the number of configurations finished after each chunk.
+    ``progress(n)`` is called with the number of configurations finished, chunk by chunk.
     """
+    global _inherited_checker
     chunks = chunk_bounds(len(configs), jobs)
     counts = np.zeros(len(checker.pairs), dtype=np.int64)
+    tick = progress or (lambda done: None)
     if jobs <= 1 or len(chunks) <= 1:
         for start, stop in chunks:
             counts += checker.count(configs[start:stop])
-            if progress:
-                progress(stop - start)
+            tick(stop - start)
         return counts
-    global _worker_checker
     method = method or start_method()
     context = multiprocessing.get_context(method)
-    inherit = method == "fork"
-    if inherit:  # the forked children find the parent's checker here; nothing to load
-        _worker_checker = checker
-    initializer, initargs = (None, ()) if inherit else (_worker_init, (source,))
+    next_chunk, results = context.Value("i", 0), context.SimpleQueue()
+    _inherited_checker = checker if method == "fork" else None
+    children = [context.Process(target=_child, daemon=True,
+                                args=(None if method == "fork" else source, configs, chunks, next_chunk, results))
+                for _ in range(min(jobs, len(chunks)) - 1)]
     try:
-        counts += _run_pool(context, min(jobs, len(chunks)), initializer, initargs, configs, chunks, source,
-                            progress)
+        for child in children:
+            child.start()
+        running = len(children)
+
+        def take(message) -> None:
+            nonlocal counts, running
+            if message == _DONE:
+                running -= 1
+            elif message[0] == "error":
+                raise UserError(f"{source.path}: a collision worker failed: {message[1]}")
+            else:
+                counts += message[1]
+                tick(message[0])
+
+        while (chunk := _claim(next_chunk, chunks)) is not None:
+            counts += checker.count(configs[chunk[0]:chunk[1]])
+            tick(chunk[1] - chunk[0])
+            while not results.empty():
+                take(results.get())
+        while running:
+            if results.empty() and not any(child.is_alive() for child in children):
+                raise UserError(f"{source.path}: a collision worker process died; rerun with --jobs 1")
+            take(results.get())
     finally:
-        if inherit:
-            _worker_checker = None
-    return counts
-
-
-def _run_pool(context, processes, initializer, initargs, configs, chunks, source, progress) -> np.ndarray:
-    counts = None
-    with context.Pool(processes=processes, initializer=initializer, initargs=initargs) as pool:
-        for size, chunk_counts in pool.imap_unordered(_worker_count,
-                                                      [configs[start:stop] for start, stop in chunks]):
-            if counts is not None and len(chunk_counts) != len(counts):
-                raise UserError(f"{source.path}: a worker process loaded a different set of links; "
-                                "did the file change during the run?")
-            counts = chunk_counts if counts is None else counts + chunk_counts
-            if progress:
-                progress(size)
+        _inherited_checker = None
+        for child in children:
+            child.join(timeout=5)
+            if child.is_alive():
+                child.terminate()
     return counts
