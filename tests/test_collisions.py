@@ -28,15 +28,22 @@ def robot_path(name, pybullet_data_dir):
     return absolute if absolute is not None else pybullet_data_dir / relative
 
 
-def brute_force_counts(model, configs) -> dict[frozenset, int]:
+BORDERLINE = 1e-3
+"""m: the two narrowphase paths (persistent-manifold contacts vs one-shot contactPairTest) may disagree
+about a pair whose surfaces are this close. Measured: on the AR3, 1 of 2,016 configurations differs
+(base_link-gripper_base: -0.09 mm by getContactPoints, +0.57 mm by getClosestPoints); panda and
+kuka_iiwa agree exactly over 2,018 and 2,017 configurations."""
+
+
+def brute_force(model, configs) -> list[dict[frozenset, float]]:
     """Independent check: a fresh client, the body loaded WITHOUT self-collision flags (so no contact
     manifolds), joints set one by one with resetJointState, and a one-shot getClosestPoints query per
-    pair of links that pybullet itself says has collision shapes.
+    pair of links that pybullet itself says has collision shapes. Per configuration: pair -> distance.
 
     The query distance is 5 mm, not 0: measured on the AR3 at "all joints at upper", getClosestPoints
     with distance=0 returns NO point for base_link-link_4 although they penetrate by 15 mm (with 1 mm
-    it returns the -15 mm point). Only points deeper than CONTACT_TOLERANCE count, as in ar3cli."""
-    counts: dict[frozenset, int] = {}
+    it returns the -15 mm point)."""
+    found = []
     with Session() as session:
         p, client = session.p, session.client
         body = session.load(model)
@@ -47,13 +54,14 @@ def brute_force_counts(model, configs) -> dict[frozenset, int]:
         for q in configs:
             for index, value in zip(movable, q):
                 p.resetJointState(body.id, index, float(value), physicsClientId=client)
+            distances = {}
             for k, a in enumerate(solid):
                 for b in solid[k + 1:]:
                     points = p.getClosestPoints(body.id, body.id, 0.005, a, b, physicsClientId=client)
-                    if any(point[8] < -CONTACT_TOLERANCE for point in points):
-                        key = frozenset((names[a], names[b]))
-                        counts[key] = counts.get(key, 0) + 1
-    return counts
+                    if points:
+                        distances[frozenset((names[a], names[b]))] = min(point[8] for point in points)
+            found.append(distances)
+    return found
 
 
 @pytest.mark.parametrize("name", sorted(ROBOTS))
@@ -65,10 +73,18 @@ def test_counts_match_independent_brute_force(name, pybullet_data_dir):
         configs = np.vstack([sample_configurations(space, 150, seed=7),
                              np.array([q for _, q in limit_configurations(space)])])
         counts = count_collisions(checker, ModelSource(path), configs)
-        ours = {frozenset((checker.links[i], checker.links[j])): int(c)
-                for (i, j), c in zip(checker.pairs, counts) if c}
-    assert sum(ours.values()) > len(configs)  # something collides: adjacent links at least
-    assert ours == brute_force_counts(model, configs)
+        label = {pair_id: frozenset((checker.links[i], checker.links[j]))
+                 for pair_id, (i, j) in enumerate(checker.pairs)}
+        ours = [{label[pair_id] for pair_id in checker.colliding(q)} for q in configs]
+    assert sum(counts) == sum(len(hits) for hits in ours) > len(configs)  # adjacent links touch at least
+    theirs = brute_force(model, configs)
+    differing = 0
+    for hits, distances in zip(ours, theirs):
+        expected = {pair for pair, distance in distances.items() if distance < -CONTACT_TOLERANCE}
+        for pair in hits ^ expected:
+            assert abs(distances.get(pair, 1.0)) < BORDERLINE, (sorted(pair), distances.get(pair))
+        differing += hits != expected
+    assert differing <= len(configs) // 100  # measured: 0 for these seeds
 
 
 def test_same_seed_same_matrix_for_any_jobs(pybullet_data_dir):
