@@ -19,6 +19,7 @@ from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.commands.lint_urdf import lint_urdf
 from ar3cli.commands.fix_inertia import fix_inertia
 from ar3cli.commands.fix_continuous import fix_continuous
+from ar3cli.commands.sample_collisions import sample_collisions
 from ar3cli.errors import EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -53,6 +54,7 @@ app.command("lint-urdf")(lint_urdf)
 app.command("grasp-demo")(grasp_demo)
 app.command("fix-inertia")(fix_inertia)
 app.command("fix-continuous")(fix_continuous)
+app.command("sample-collisions")(sample_collisions)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -1,0 +1,273 @@
+"""The self-collision matrix: classify link pairs like MoveIt Setup Assistant, with statistics.
+
+Categories, in MoveIt's order of precedence (``compute_default_collisions.cpp``):
+
+1. ``adjacent``: joined by a joint, links without collision geometry being transparent (removed and
+   their neighbours joined), so parent and grandchild across a geometry-less link are adjacent.
+2. ``default``: in contact at the home pose (0, or mid-range where 0 is outside the limits).
+3. ``always``: in contact in at least ``always_threshold`` (0.95) of the uniform samples.
+4. ``never``: never in contact, neither in the uniform samples nor in any limit configuration
+   (MoveIt has no limit samples; a pair that only touches at a joint limit stays enabled here).
+   Reported with the exact one-sided 95% upper bound on its collision probability,
+   ``1 - 0.05 ** (1 / N)`` (about 3/N): "never seen" is not "impossible".
+5. ``sometimes``: everything else, with the fraction and a Wilson 95% interval. Kept enabled.
+
+The first four are the pairs MoveIt disables (``<disable_collisions reason="Adjacent|Default|
+Always|Never"/>``) and the pairs to pass to ``setCollisionFilterPair`` in PyBullet.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ar3cli.findings import Finding, Severity
+from ar3cli.model import Model
+
+CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
+DISABLED = ("adjacent", "default", "always", "never")
+SRDF_REASONS = {"adjacent": "Adjacent", "default": "Default", "always": "Always", "never": "Never"}
+Z_95 = 1.959963984540054
+
+
+def wilson_interval(successes: int, trials: int, z: float = Z_95) -> tuple[float, float]:
+    """Wilson score interval for a binomial proportion (95% by default); (0, 1) with no trials."""
+    if trials <= 0:
+        return 0.0, 1.0
+    phat = successes / trials
+    denominator = 1 + z * z / trials
+    centre = (phat + z * z / (2 * trials)) / denominator
+    half = z * math.sqrt(phat * (1 - phat) / trials + z * z / (4 * trials * trials)) / denominator
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def zero_success_upper_bound(trials: int, confidence: float = 0.95) -> float:
+    """Exact one-sided upper bound on p after ``trials`` clean trials: 1 - (1 - c) ** (1 / N) ~ 3/N."""
+    if trials <= 0:
+        return 1.0
+    return 1.0 - (1.0 - confidence) ** (1.0 / trials)
+
+
+def adjacent_pairs(model: Model, with_geometry: Iterable[str]) -> set[frozenset[str]]:
+    """Pairs of links with geometry joined by a joint, looking through links without geometry.
+
+    Walks the joint graph (undirected) from each link with geometry, passing through links without
+    geometry, stopping at the first link with geometry on each path: panda_link7 - (link8) -
+    panda_hand is adjacent.
+    """
+    solid = set(with_geometry)
+    neighbours: dict[str, set[str]] = {}
+    for joint in model.joints:
+        if joint.parent and joint.child:
+            neighbours.setdefault(joint.parent, set()).add(joint.child)
+            neighbours.setdefault(joint.child, set()).add(joint.parent)
+    pairs: set[frozenset[str]] = set()
+    for start in solid:
+        seen, frontier = {start}, [start]
+        while frontier:
+            link = frontier.pop()
+            for other in neighbours.get(link, ()):
+                if other in seen:
+                    continue
+                seen.add(other)
+                if other in solid:
+                    pairs.add(frozenset((start, other)))
+                else:
+                    frontier.append(other)
+    return pairs
+
+
+def direct_parent_child(model: Model) -> set[frozenset[str]]:
+    """Pairs a joint joins directly: the only ones URDF_USE_SELF_COLLISION leaves out."""
+    return {frozenset((j.parent, j.child)) for j in model.joints if j.parent and j.child}
+
+
+@dataclass
+class PairResult:
+    """One pair of links with collision geometry and what the sampling found."""
+
+    link_a: str
+    link_b: str
+    category: str
+    collisions: int
+    samples: int
+    at_home: bool
+    limit_hits: list[str] = field(default_factory=list)
+
+    @property
+    def fraction(self) -> float:
+        return self.collisions / self.samples if self.samples else 0.0
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return wilson_interval(self.collisions, self.samples)
+
+    @property
+    def upper_bound(self) -> float:
+        """95% upper bound on the collision probability: exact when never seen, else Wilson's."""
+        if self.collisions == 0:
+            return zero_success_upper_bound(self.samples)
+        return self.interval[1]
+
+    def to_dict(self) -> dict:
+        low, high = self.interval
+        return {"link_a": self.link_a, "link_b": self.link_b, "category": self.category,
+                "collisions": self.collisions, "fraction": self.fraction, "upper_bound": self.upper_bound,
+                "interval_95": [low, high], "at_home": self.at_home, "limit_hits": self.limit_hits}
+
+
+def classify(
+    links: Sequence[str],
+    pairs: Sequence[tuple[int, int]],
+    counts: Sequence[int],
+    samples: int,
+    adjacent: set[frozenset[str]],
+    home_hits: set[int],
+    limit_hits: dict[int, list[str]],
+    always_threshold: float = 0.95,
+) -> list[PairResult]:
+    """One :class:`PairResult` per pair, categorised adjacent > default > always > never > sometimes."""
+    results = []
+    for pair_id, (i, j) in enumerate(pairs):
+        a, b = links[i], links[j]
+        collisions = int(counts[pair_id])
+        hits = limit_hits.get(pair_id, [])
+        if frozenset((a, b)) in adjacent:
+            category = "adjacent"
+        elif pair_id in home_hits:
+            category = "default"
+        elif samples and collisions / samples >= always_threshold:
+            category = "always"
+        elif collisions == 0 and not hits:
+            category = "never"
+        else:
+            category = "sometimes"
+        results.append(PairResult(a, b, category, collisions, samples, pair_id in home_hits, hits))
+    return results
+
+
+def category_counts(results: Iterable[PairResult]) -> dict[str, int]:
+    counts = {category: 0 for category in CATEGORIES}
+    for result in results:
+        counts[result.category] += 1
+    return counts
+
+
+def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
+             always_threshold: float) -> list[Finding]:
+    """What users trip over: visual-only links, contact at home, pairs pybullet's default flag
+    checks although they always touch, pairs that touch only at a joint limit."""
+    path = str(model.path)
+    found: list[Finding] = []
+    visual_only = [link for link in model.links if link.visuals and link.name not in links]
+    if visual_only:
+        names = ", ".join(link.name for link in visual_only)
+        found.append(Finding("visual-only-links", Severity.WARNING,
+                             f"{len(visual_only)} link(s) have <visual> but no <collision>: {names}; they never "
+                             "collide and count as transparent for adjacency", path, visual_only[0].line,
+                             hint="add <collision> elements (a primitive around the visual) if they can hit "
+                                  "anything"))
+    adjacent_direct = direct_parent_child(model)
+    for result in results:
+        key = frozenset((result.link_a, result.link_b))
+        label = f"{result.link_a} - {result.link_b}"
+        if result.at_home and result.category != "adjacent":
+            found.append(Finding("contact-at-home", Severity.WARNING,
+                                 f"{label} are in contact at the home pose but not adjacent", path,
+                                 hint="usually a modelling error (check the collision origins and sizes); "
+                                      "PyBullet's URDF_USE_SELF_COLLISION would report this contact too"))
+        elif key not in adjacent_direct and result.fraction >= always_threshold:
+            found.append(Finding("pybullet-default-self-collision", Severity.WARNING,
+                                 f"{label} are in contact in {result.fraction:.0%} of samples and PyBullet's "
+                                 "URDF_USE_SELF_COLLISION checks them (it skips only direct parent-child pairs)",
+                                 path, hint="disable the pair with setCollisionFilterPair (see --pybullet-filter)"))
+        if result.collisions == 0 and result.limit_hits:
+            found.append(Finding("contact-only-at-limits", Severity.INFO,
+                                 f"{label} never collided in {result.samples} uniform samples but do at "
+                                 f"{', '.join(result.limit_hits)}; kept enabled (MoveIt would disable it)",
+                                 path))
+    return found
+
+
+# ---- export -------------------------------------------------------------------------------------
+def disabled_pairs(results: Iterable[PairResult]) -> list[PairResult]:
+    return [result for result in results if result.category in DISABLED]
+
+
+def srdf_bytes(robot_name: str, results: Sequence[PairResult], comment: str = "") -> bytes:
+    """An SRDF with one ``<disable_collisions link1 link2 reason/>`` per disabled pair, MoveIt-style."""
+    from lxml import etree
+
+    root = etree.Element("robot", name=robot_name or "robot")
+    if comment:
+        root.append(etree.Comment(f" {comment} "))
+    for result in disabled_pairs(results):
+        etree.SubElement(root, "disable_collisions", link1=result.link_a, link2=result.link_b,
+                         reason=SRDF_REASONS[result.category])
+    return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
+
+
+def pybullet_filter_bytes(results: Sequence[PairResult], comment: str = "") -> bytes:
+    """JSON pair list for ``setCollisionFilterPair(body, body, link_index[a], link_index[b], 0)``."""
+    document = {"comment": comment,
+                "usage": "for each pair: p.setCollisionFilterPair(body, body, index[link_a], index[link_b], 0)",
+                "pairs": [{"link_a": r.link_a, "link_b": r.link_b, "reason": SRDF_REASONS[r.category]}
+                          for r in disabled_pairs(results)]}
+    return (json.dumps(document, indent=2) + "\n").encode("utf-8")
+
+
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write via a temporary file in the same folder and rename, so a reader never sees half a file."""
+    path = Path(path)
+    directory = path.parent if str(path.parent) else Path(".")
+    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=directory)
+    try:
+        with os.fdopen(handle, "wb") as stream:
+            stream.write(data)
+        os.replace(temporary, path)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+# ---- heat map -------------------------------------------------------------------------------------
+HEAT_STYLES = {"adjacent": "blue", "default": "bold red", "always": "magenta", "never": "green",
+               "sometimes": "yellow"}
+HEAT_LEGEND = ("A adjacent, D default (touching at home), X always, . never, "
+               "1-9 sometimes (tenths of samples, 1 = under 10%), "
+               "L only at a joint limit")
+
+
+def heat_char(result: PairResult) -> str:
+    """One character per pair: its category, or the colliding fraction in tenths for 'sometimes'."""
+    if result.category == "sometimes":
+        return str(min(9, max(1, math.ceil(result.fraction * 10 - 1e-12)))) if result.collisions else "L"
+    return {"adjacent": "A", "default": "D", "always": "X", "never": "."}[result.category]
+
+
+def heat_map(links: Sequence[str], pairs: Sequence[tuple[int, int]], results: Sequence[PairResult]):
+    """A lower-triangular link x link grid as rich Text (colour by category; plain chars without colour)."""
+    from rich.text import Text
+
+    cell = {pair: result for pair, result in zip(pairs, results)}
+    width = max((len(name) for name in links), default=0)
+    digits = len(str(max(len(links) - 1, 0)))
+    text = Text()
+    header = " " * (width + digits + 2) + " ".join(str(k % 10) for k in range(len(links)))
+    text.append(header + "\n")
+    for i, name in enumerate(links):
+        text.append(f"{name:>{width}} {i:>{digits}} ")
+        for j in range(len(links)):
+            if j >= i:
+                break
+            result = cell[(j, i)]
+            text.append(heat_char(result), style=HEAT_STYLES[result.category])
+            text.append(" ")
+        text.append("\n")
+    text.append(HEAT_LEGEND)
+    return text
