@@ -20,11 +20,8 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from ar3cli.findings import Finding, Severity
 from ar3cli.model import Model
@@ -219,20 +216,6 @@ def pybullet_filter_bytes(results: Sequence[PairResult], comment: str = "") -> b
                 "pairs": [{"link_a": r.link_a, "link_b": r.link_b, "reason": SRDF_REASONS[r.category]}
                           for r in disabled_pairs(results)]}
     return (json.dumps(document, indent=2) + "\n").encode("utf-8")
-
-
-def write_atomic(path: Path, data: bytes) -> None:
-    """Write via a temporary file in the same folder and rename, so a reader never sees half a file."""
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    handle, temporary = tempfile.mkstemp(prefix=f".{path.name}.", dir=directory)
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            stream.write(data)
-        os.replace(temporary, path)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
 
 
 # ---- heat map -------------------------------------------------------------------------------------

@@ -1,4 +1,4 @@
-"""Byte-preserving edits of an XML file, and atomic writes.
+"""Byte-preserving edits of an XML file.
 
 The fixers must change only the elements they fix: every comment, attribute order, quote
 character, indentation, blank line, line ending and the XML declaration stay byte for byte.
@@ -10,32 +10,16 @@ lxml elements, so an lxml element is mapped to its span by its index in that ord
 
 Edits are collected as non-overlapping splices ``(start, end, new_bytes)`` and applied in one
 go by :meth:`Document.apply`. New text is ASCII, so it is valid in any ASCII-compatible
-encoding the file may declare.
-
-:func:`atomic_write` writes a temporary file in the target's folder (named
-``.<name>.ar3cli-tmp-XXXX`` so a stray one is recognisable), fsyncs it, copies the original's
-mode bits and renames it over the target: a crash or a kill at any moment leaves either the old
-file or the new one, never a mix.
+encoding the file may declare. Writing the result is :func:`ar3cli.atomic.atomic_write`'s job.
 """
 
 from __future__ import annotations
 
-import os
 import re
-import tempfile
-import time
 from collections import Counter
 from dataclasses import dataclass, field
-from pathlib import Path
 
 from ar3cli.errors import UserError
-
-TEMP_MARKER = ".ar3cli-tmp-"
-"""Part of every temporary file name written by :func:`atomic_write`."""
-
-SLOW_WRITE_ENV = "AR3CLI_TEST_SLOW_WRITE"
-"""For tests only: seconds to sleep between chunks of the temporary file, so a test can kill
-the process mid-write and check that the target is intact."""
 
 _NAME = re.compile(rb"[^\s/>=]+")
 _ATTRIBUTE = re.compile(rb"""(\s+)([^\s/>=]+)(\s*=\s*)(?:"([^"]*)"|'([^']*)')""")
@@ -315,70 +299,3 @@ def _indent_unit(data: bytes, spans: list[Span]) -> bytes:
             continue
         counts[mine[len(theirs):]] += 1
     return counts.most_common(1)[0][0] if counts else b"  "
-
-
-# ---- atomic writes ---------------------------------------------------------------------------
-def atomic_write(path: Path, data: bytes, validate=None) -> None:
-    """Replace ``path`` with ``data`` atomically; ``validate(temp_path)`` may raise to abort.
-
-    The temporary file lives in the same folder (so the rename is atomic on one filesystem),
-    is fsynced before the rename and gets the original's mode bits. On any failure it is
-    removed and the original is untouched.
-    """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
-    try:
-        mode = path.stat().st_mode & 0o7777
-    except FileNotFoundError:
-        umask = os.umask(0)
-        os.umask(umask)
-        mode = 0o666 & ~umask
-    try:
-        handle, temp_name = tempfile.mkstemp(prefix=f".{path.name}{TEMP_MARKER}", dir=directory)
-    except OSError as exc:
-        raise UserError(f"{path}: cannot write in {directory}: {exc.strerror or exc}") from None
-    temp = Path(temp_name)
-    try:
-        with os.fdopen(handle, "wb") as stream:
-            _write_chunks(stream, data)
-            stream.flush()
-            os.fsync(stream.fileno())
-        os.chmod(temp, mode)
-        if validate is not None:
-            validate(temp)
-        os.replace(temp, path)
-    except BaseException:
-        temp.unlink(missing_ok=True)
-        raise
-    _fsync_directory(directory)
-
-
-def _write_chunks(stream, data: bytes) -> None:
-    delay = float(os.environ.get(SLOW_WRITE_ENV, "0") or 0)
-    if delay <= 0:
-        stream.write(data)
-        return
-    chunk = max(1, len(data) // 10)
-    for start in range(0, len(data), chunk):
-        stream.write(data[start:start + chunk])
-        stream.flush()
-        time.sleep(delay)
-
-
-def _fsync_directory(directory: Path) -> None:
-    """Make the rename itself durable (best effort; not every platform allows it)."""
-    try:
-        fd = os.open(directory, os.O_RDONLY)
-    except OSError:
-        return
-    try:
-        os.fsync(fd)
-    except OSError:
-        pass
-    finally:
-        os.close(fd)
-
-
-def stale_temps(directory: Path) -> list[Path]:
-    """Leftover temporary files of a killed run in ``directory`` (safe to delete)."""
-    return sorted(p for p in Path(directory).glob(f".*{TEMP_MARKER}*") if p.is_file())

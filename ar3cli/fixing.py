@@ -18,7 +18,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ar3cli.edits import Document, atomic_write
+from ar3cli.atomic import atomic_write
+from ar3cli.edits import Document
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
 from ar3cli.output import OutputFormat, Report, Table, console, render, render_table
 

@@ -9,12 +9,13 @@ error never builds up).
 
 from __future__ import annotations
 
+import io
 import os
-import tempfile
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+from ar3cli.atomic import atomic_write
 from ar3cli.errors import UserError
 
 
@@ -84,19 +85,17 @@ class GifRecorder:
         if not self.frames:
             raise UserError("nothing was recorded")
         path = Path(path)
-        handle, temp = tempfile.mkstemp(prefix=f".{path.stem}-", suffix=".gif", dir=path.parent or ".")
-        os.close(handle)
+        # one palette for every frame (from the last one, when the scene has changed the
+        # most), so colours do not flicker between frames
+        palette = self.frames[-1].quantize(colors=128, dither=0)
+        first, *rest = [frame.quantize(palette=palette, dither=0) for frame in self.frames]
+        buffer = io.BytesIO()
+        first.save(buffer, format="GIF", save_all=True, append_images=rest, duration=self.durations_ms(),
+                   loop=0, optimize=False, disposal=1)
+        with Image.open(io.BytesIO(buffer.getvalue())) as written:
+            count = written.n_frames
         try:
-            # one palette for every frame (from the last one, when the scene has changed the
-            # most), so colours do not flicker between frames
-            palette = self.frames[-1].quantize(colors=128, dither=0)
-            first, *rest = [frame.quantize(palette=palette, dither=0) for frame in self.frames]
-            first.save(temp, format="GIF", save_all=True, append_images=rest, duration=self.durations_ms(),
-                       loop=0, optimize=False, disposal=1)
-            with Image.open(temp) as written:
-                count = written.n_frames
-            os.replace(temp, path)
+            atomic_write(path, buffer.getvalue())
         except OSError as exc:
-            Path(temp).unlink(missing_ok=True)
             raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
         return count

@@ -10,11 +10,13 @@ they are not joined to are drawn red: the picture shows what ``lint-urdf --sim``
 from __future__ import annotations
 
 import copy
+import io
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ar3cli.atomic import atomic_write
 from ar3cli.errors import UserError
 from ar3cli.model import Model
 
@@ -100,8 +102,10 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
             session.p.changeVisualShape(body.id, body.link_index[link_name], rgbaColor=CONTACT_RGBA,
                                         physicsClientId=session.client)
         rgb = _snapshot(session, body, width, height, yaw_deg, pitch_deg)
+    buffer = io.BytesIO()
+    Image.fromarray(rgb).save(buffer, format="PNG")
     output.parent.mkdir(parents=True, exist_ok=True)
-    Image.fromarray(rgb).save(output, format="PNG")
+    atomic_write(output, buffer.getvalue())
     return RenderResult(output, width, height, values, contacts)
 
 

@@ -13,7 +13,8 @@ from pathlib import Path
 import pytest
 from conftest import ASSETS, REPO
 
-from ar3cli.edits import TEMP_MARKER, Document, atomic_write, stale_temps
+from ar3cli.atomic import TEMP_MARKER, atomic_write, stale_temps
+from ar3cli.edits import Document
 from ar3cli.model import load_model
 
 NASTY = (

@@ -22,7 +22,7 @@ ThresholdOption = Annotated[float, typer.Option("--always-threshold", min=0.01, 
                                                 help="A pair in contact in at least this fraction of samples "
                                                      "is 'always' colliding.")]
 SrdfOption = Annotated[Optional[Path], typer.Option("--srdf", metavar="OUT", dir_okay=False,
-                                                    help="Write MoveIt <disable_collisions> entries to this "
+                                                    help="Write MoveIt `<disable_collisions>` entries to this "
                                                          "SRDF file.")]
 FilterOption = Annotated[Optional[Path], typer.Option("--pybullet-filter", metavar="OUT", dir_okay=False,
                                                       help="Write the disabled pairs as JSON for PyBullet's "
@@ -153,10 +153,10 @@ class _progress:
 
 
 def _write(path: Path, data: bytes) -> None:
-    from ar3cli.collision_matrix import write_atomic
+    from ar3cli.atomic import atomic_write
 
     try:
-        write_atomic(path, data)
+        atomic_write(path, data)
     except OSError as exc:
         raise UserError(f"{path}: cannot write: {exc.strerror or exc}") from None
 
