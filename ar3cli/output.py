@@ -51,6 +51,8 @@ class Report:
     tables: list[Table] = field(default_factory=list)
     lines: list[str] = field(default_factory=list)
     ok: bool = True
+    renderables: list[Any] = field(default_factory=list)
+    """Extra rich renderables (e.g. a heat map), printed after the tables in text mode."""
 
 
 def _plain() -> bool:
@@ -133,6 +135,11 @@ def render(report: Report, fmt: OutputFormat | str) -> None:
     out = console()
     for table in report.tables:
         render_table(table, out)
+    for renderable in report.renderables:
+        out.print()
+        out.print(renderable)
+    if report.renderables:
+        out.print()
     for line in report.lines:
         out.print(line, markup=False)
 

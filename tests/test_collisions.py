@@ -151,6 +151,20 @@ def test_cli_ar3_text_and_jobs(cli):
     assert "finger_left" in text.stdout and "A adjacent" in text.stdout  # table and heat map legend
 
 
+def test_png_heat_map(cli, tmp_path):
+    from PIL import Image
+
+    out = tmp_path / "matrix.png"
+    result = cli("sample-collisions", str(ASSETS / "ar3" / "ar3.urdf"), "-n", "200", "--png", str(out))
+    assert result.code == 0, result.stderr
+    image = Image.open(out).convert("RGB")
+    assert image.width > 200 and image.height > 200
+    colours = {colour for _, colour in image.getcolors(maxcolors=1 << 16)}
+    from ar3cli.heatmap_png import CATEGORY_COLOURS
+
+    assert CATEGORY_COLOURS["adjacent"] in colours and CATEGORY_COLOURS["never"] in colours
+
+
 TRANSPARENT = """<?xml version="1.0"?>
 <robot name="chain">
   <link name="base"><collision><geometry><box size="0.2 0.2 0.1"/></geometry></collision></link>

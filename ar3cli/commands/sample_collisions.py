@@ -24,6 +24,8 @@ ThresholdOption = Annotated[float, typer.Option("--always-threshold", min=0.01, 
 SrdfOption = Annotated[Optional[Path], typer.Option("--srdf", metavar="OUT", dir_okay=False,
                                                     help="Write MoveIt `<disable_collisions>` entries to this "
                                                          "SRDF file.")]
+PngOption = Annotated[Optional[Path], typer.Option("--png", metavar="OUT.png", dir_okay=False,
+                                                 help="Draw the pair matrix as a heat map picture.")]
 FilterOption = Annotated[Optional[Path], typer.Option("--pybullet-filter", metavar="OUT", dir_okay=False,
                                                       help="Write the disabled pairs as JSON for PyBullet's "
                                                            "setCollisionFilterPair.")]
@@ -37,6 +39,7 @@ def sample_collisions(
     always_threshold: ThresholdOption = 0.95,
     srdf: SrdfOption = None,
     pybullet_filter: FilterOption = None,
+    png: PngOption = None,
     format: FormatOption = OutputFormat.text,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
@@ -67,6 +70,11 @@ def sample_collisions(
         _write(srdf, cm.srdf_bytes(model.name or "robot", results, comment))
     if pybullet_filter is not None:
         _write(pybullet_filter, cm.pybullet_filter_bytes(results, comment))
+    if png is not None:
+        from ar3cli.heatmap_png import heat_map_png
+
+        _write(png, heat_map_png(links, pairs, results, title=f"{model.name or model.path.name}: "
+                                                             f"{samples} samples, seed {seed}"))
     _render(model, results, links, pairs, warnings, run, samples, seed, jobs, always_threshold, format)
     raise typer.Exit(EXIT_OK)
 
@@ -190,11 +198,6 @@ def _render(model, results, links, pairs, warnings, run, samples, seed, jobs, th
                   columns=["link a", "link b", "category", "collisions", "fraction", "95% interval",
                            "at home", "limit hits"],
                   rows=rows, numeric_columns=("collisions", "fraction", "limit hits"))
-    render(Report(data=data, tables=[table]), fmt)
-    out = console()
-    out.print()
-    out.print(cm.heat_map(links, pairs, results))
-    out.print()
     summary = ", ".join(f"{counts[c]} {c}" for c in cm.CATEGORIES)
     lines = [
         f"seed {seed}: {samples} uniform samples + {run['limits']} home/limit configurations, "
@@ -205,9 +208,8 @@ def _render(model, results, links, pairs, warnings, run, samples, seed, jobs, th
         f"{rate:,.0f} configurations/s with {jobs} job{'s' if jobs != 1 else ''}" if rate else "",
     ]
     lines += [f"{w.severity.value}: {w.message}" + (f" ({w.hint})" if w.hint else "") for w in warnings]
-    for line in lines:
-        if line:
-            out.print(line, markup=False)
+    render(Report(data=data, tables=[table], renderables=[cm.heat_map(links, pairs, results)],
+                  lines=[line for line in lines if line]), fmt)
 
 
 def _tolerance() -> float:
