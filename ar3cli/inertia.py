@@ -55,12 +55,13 @@ def shape_mass(shape: Shape, cache: dict | None = None) -> tuple[mp.MassProperti
     kind = geometry.kind
     if kind == "box":
         size = params.get("size")
-        if not size or min(size) <= 0 or not all(map(math.isfinite, size)):
+        if not size or not all(map(_positive, size)):
             raise GeometryError(f"box size {size!r} is not usable")
         props, source = mp.box(size, density=1.0), f"box {'x'.join(_fmt(s) for s in size)} analytic"
     elif kind in ("cylinder", "capsule"):
         radius, length = params.get("radius"), params.get("length")
-        if radius is None or length is None or radius <= 0 or length < 0:
+        min_length_ok = _positive(length) or (kind == "capsule" and length == 0)  # a capsule may be a sphere
+        if not _positive(radius) or not min_length_ok:
             raise GeometryError(f"{kind} radius {radius!r} length {length!r} is not usable")
         if kind == "cylinder":
             props, source = mp.cylinder(radius, length, density=1.0), f"cylinder r={_fmt(radius)} l={_fmt(length)} analytic"
@@ -68,7 +69,7 @@ def shape_mass(shape: Shape, cache: dict | None = None) -> tuple[mp.MassProperti
             props, source = capsule(radius, length), f"capsule r={_fmt(radius)} l={_fmt(length)} analytic"
     elif kind == "sphere":
         radius = params.get("radius")
-        if radius is None or radius <= 0:
+        if not _positive(radius):
             raise GeometryError(f"sphere radius {radius!r} is not usable")
         props, source = mp.sphere(radius, density=1.0), f"sphere r={_fmt(radius)} analytic"
     elif kind == "mesh":
@@ -76,6 +77,11 @@ def shape_mass(shape: Shape, cache: dict | None = None) -> tuple[mp.MassProperti
     else:
         raise GeometryError(f"geometry <{params.get('tag', 'missing')}> has no volume")
     return mp.transformed(props, shape.origin.xyz, shape.origin.rpy), source
+
+
+def _positive(value: float | None) -> bool:
+    """A usable dimension: a finite number above zero (NaN and inf are not)."""
+    return value is not None and math.isfinite(value) and value > 0
 
 
 def capsule(radius: float, length: float) -> mp.MassProperties:

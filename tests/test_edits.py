@@ -11,7 +11,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import ASSETS, REPO
+from tests.conftest import ASSETS, REPO
 
 from ar3cli.atomic import TEMP_MARKER, atomic_write, stale_temps
 from ar3cli.edits import Document

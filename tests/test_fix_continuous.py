@@ -7,8 +7,8 @@ import math
 from pathlib import Path
 
 import pytest
-from conftest import ASSETS
-from fixer_helpers import element_lines, lint_findings, only_within, write
+from tests.conftest import ASSETS
+from tests.fixer_helpers import element_lines, lint_findings, only_within, write
 
 from ar3cli.model import load_model
 

@@ -8,8 +8,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from conftest import ASSETS
-from fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write
+from tests.conftest import ASSETS
+from tests.fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write
 
 from ar3cli import mass_properties as mp
 from ar3cli.inertia import capsule, links_needing_inertia
@@ -310,3 +310,17 @@ def test_real_ar3_link_3_com_one_metre_away_is_fixed_on_request(cli, tmp_path, s
     mass, com, _ = inertial_of(path, "link_3")
     assert mass == 0.1787 and np.linalg.norm(com) < 0.1
     assert cli("fix-inertia", str(path), "--links", "link_3", "--check", "--package-path", package).code == 0
+
+
+@pytest.mark.parametrize("geometry", ['<cylinder radius="0.1" length="0"/>', '<cylinder radius="nan" length="0.2"/>',
+                                      '<sphere radius="nan"/>', '<box size="0.1 inf 0.1"/>'])
+def test_degenerate_primitives_are_skipped_with_a_reason(cli, write_urdf, geometry):
+    path = write_urdf('<robot name="d"><link name="a"/><joint name="j" type="revolute"><parent link="a"/>'
+                      '<child link="b"/><axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/>'
+                      f'</joint><link name="b"><collision><geometry>{geometry}</geometry></collision></link></robot>')
+    before = path.read_bytes()
+    result = cli("fix-inertia", str(path), "--density", "1000", "--format", "json")
+    assert result.code == 1, result.stderr
+    (skipped,) = json.loads(result.stdout)["files"][0]["skipped"]
+    assert "is not usable" in skipped["reason"]
+    assert path.read_bytes() == before and "internal error" not in result.stderr
