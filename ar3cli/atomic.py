@@ -28,10 +28,13 @@ def atomic_write(path: Path, data: bytes, validate=None) -> None:
 
     The temporary file lives in the same folder (so the rename is atomic on one filesystem),
     is fsynced before the rename and gets the original's mode bits. On any failure it is
-    removed and the original is untouched.
+    removed and the original is untouched; an OS error becomes a one-line :class:`UserError`.
+    A symlink is written through (its target changes, the link stays a link).
     """
-    path = Path(path)
-    directory = path.parent if str(path.parent) else Path(".")
+    path = Path(os.path.realpath(path))
+    directory = path.parent
+    if path.is_dir():
+        raise UserError(f"{path}: is a directory; give a file name")
     try:
         mode = path.stat().st_mode & 0o7777
     except FileNotFoundError:
@@ -52,6 +55,9 @@ def atomic_write(path: Path, data: bytes, validate=None) -> None:
         if validate is not None:
             validate(temp)
         os.replace(temp, path)
+    except OSError as exc:
+        temp.unlink(missing_ok=True)
+        raise UserError(f"{path}: cannot write: {exc.strerror or exc}") from None
     except BaseException:
         temp.unlink(missing_ok=True)
         raise

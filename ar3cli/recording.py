@@ -94,8 +94,5 @@ class GifRecorder:
                    loop=0, optimize=False, disposal=1)
         with Image.open(io.BytesIO(buffer.getvalue())) as written:
             count = written.n_frames
-        try:
-            atomic_write(path, buffer.getvalue())
-        except OSError as exc:
-            raise UserError(f"cannot write {path}: {exc.strerror or exc}") from None
+        atomic_write(path, buffer.getvalue())
         return count

@@ -155,3 +155,27 @@ def test_kill_mid_write_leaves_the_old_file(tmp_path):
     subprocess.run([sys.executable, "-m", "ar3cli", "fix-continuous", str(target), "--no-verify"], env=env,
                    check=True, capture_output=True)
     assert b'lower="-100"' not in target.read_bytes() and stale_temps(tmp_path) == []
+
+
+def test_atomic_write_follows_symlinks_and_refuses_directories(tmp_path):
+    import pytest
+
+    from ar3cli.errors import UserError
+
+    real = tmp_path / "real.urdf"
+    real.write_bytes(b"old")
+    link = tmp_path / "link.urdf"
+    link.symlink_to(real)
+    atomic_write(link, b"new")
+    assert link.is_symlink() and real.read_bytes() == b"new"
+    with pytest.raises(UserError, match="is a directory"):
+        atomic_write(tmp_path, b"x")
+    (tmp_path / "ro").mkdir()
+    (tmp_path / "ro").chmod(0o500)
+    try:
+        if os.access(tmp_path / "ro", os.W_OK):
+            pytest.skip("running as a user who can write anywhere")
+        with pytest.raises(UserError, match="cannot write"):
+            atomic_write(tmp_path / "ro" / "x.urdf", b"x")
+    finally:
+        (tmp_path / "ro").chmod(0o700)

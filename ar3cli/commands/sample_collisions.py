@@ -163,10 +163,7 @@ class _progress:
 def _write(path: Path, data: bytes) -> None:
     from ar3cli.atomic import atomic_write
 
-    try:
-        atomic_write(path, data)
-    except OSError as exc:
-        raise UserError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    atomic_write(path, data)
 
 
 def _render(model, results, links, pairs, warnings, run, samples, seed, jobs, threshold, fmt) -> None:
