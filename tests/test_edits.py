@@ -170,6 +170,13 @@ def test_atomic_write_follows_symlinks_and_refuses_directories(tmp_path):
     assert link.is_symlink() and real.read_bytes() == b"new"
     with pytest.raises(UserError, match="is a directory"):
         atomic_write(tmp_path, b"x")
+
+
+def test_atomic_write_into_read_only_folder_is_a_user_error(tmp_path):
+    import pytest
+
+    from ar3cli.errors import UserError
+
     (tmp_path / "ro").mkdir()
     (tmp_path / "ro").chmod(0o500)
     try:
