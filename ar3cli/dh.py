@@ -123,6 +123,9 @@ def load_dh(path: Path, model: Model) -> DHTable:
             raise UserError(f"{where}: {role} link {name!r} is not a link of {model.path.name}")
     chain = chain_joints(model, base, tip, where)
     movable = [joint for joint in chain if joint.type != "fixed"]
+    if not movable:
+        raise UserError(f"{where}: the chain {base} -> {tip} has no movable joint, so there is nothing for a DH "
+                        "table to describe; choose base and tip links with joints between them")
     rows = document["joints"]
     if not isinstance(rows, list):
         raise UserError(f"{where}: joints must be a list of rows")

@@ -243,6 +243,7 @@ def test_wrong_dh_fails_on_the_cli_with_diagnosis(cli, tmp_path: Path) -> None:
      "joints[0] is missing 'd'"),
     (lambda d: {**d, "units": {"length": "inch"}}, "length unit 'inch' is not supported"),
     (lambda d: {**d, "joints": [d["joints"][1], d["joints"][0], *d["joints"][2:]]}, "rows go in chain order"),
+    (lambda d: {**d, "base": "link_6", "tip": "tcp", "joints": []}, "has no movable joint"),
 ])
 def test_bad_dh_files_exit_2_with_one_line(cli, tmp_path: Path, mutate, expected: str) -> None:
     document = mutate(yaml.safe_load(AR3_DH.read_text(encoding="utf-8")))
