@@ -12,7 +12,6 @@ xacro, builds the new bytes, checks they still parse, prints a diff (``--diff``)
 from __future__ import annotations
 
 import difflib
-import sys
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -21,7 +20,7 @@ from typing import Any
 from ar3cli.atomic import atomic_write
 from ar3cli.edits import Document
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
-from ar3cli.output import OutputFormat, Report, Table, console, render, render_table
+from ar3cli.output import OutputFormat, Report, Table, render
 
 
 @dataclass
@@ -187,15 +186,6 @@ def _report(command: str, results: list[FileResult], *, diff: bool, check: bool,
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) changed, written to {r.written}")
         else:
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) would change")
-    if OutputFormat(fmt) is OutputFormat.text and diff:
-        sys.stdout.write("".join(r.diff for r in results))
-        sys.stdout.flush()
-        err = console(stderr=True)
-        for table in tables:
-            if table.rows:
-                render_table(table, err)
-        for line in lines:
-            err.print(line, markup=False)
-        return code
-    render(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK), fmt)
+    patch = "".join(r.diff for r in results) if diff else ""
+    render(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK, text=patch), fmt)
     return code

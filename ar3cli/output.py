@@ -14,7 +14,7 @@ import math
 import os
 import sys
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NoReturn
 
 
 class OutputFormat(str, enum.Enum):
@@ -53,10 +53,9 @@ class Report:
     ok: bool = True
     renderables: list[Any] = field(default_factory=list)
     """Extra rich renderables (e.g. a heat map), printed after the tables in text mode."""
-
-
-def _plain() -> bool:
-    return bool(os.environ.get("NO_COLOR")) or not sys.stdout.isatty()
+    text: str = ""
+    """A verbatim payload for stdout (a unified diff, workflow annotations, Markdown). When set, text
+    mode writes it to stdout alone and moves tables and lines to stderr, so the payload can be piped."""
 
 
 def console(stderr: bool = False):
@@ -91,7 +90,7 @@ def render_table(table: Table, out=None) -> None:
     from rich.text import Text
 
     out = out or console()
-    plain = _plain()
+    plain = out.no_color
     rich_table = RichTable(title=table.title or None, caption=table.caption or None,
                            box=box.ASCII2 if plain else box.ROUNDED, title_justify="left",
                            caption_justify="left", header_style="" if plain else "bold")
@@ -128,11 +127,15 @@ def _json_default(value: Any) -> Any:
 
 
 def render(report: Report, fmt: OutputFormat | str) -> None:
-    """Render ``report`` in ``fmt``: all tables then the summary lines, or the JSON document."""
-    if OutputFormat(fmt) is OutputFormat.json:
+    """Render ``report``: the JSON document for ``json``; otherwise the verbatim text (if any) on
+    stdout, then all tables, renderables and summary lines (on stderr when there was verbatim text)."""
+    if str(getattr(fmt, "value", fmt)) == OutputFormat.json.value:
         emit_json(report.data)
         return
-    out = console()
+    if report.text:
+        sys.stdout.write(report.text)
+        sys.stdout.flush()
+    out = console(stderr=bool(report.text))
     for table in report.tables:
         render_table(table, out)
     for renderable in report.renderables:
@@ -142,6 +145,14 @@ def render(report: Report, fmt: OutputFormat | str) -> None:
         out.print()
     for line in report.lines:
         out.print(line, markup=False)
+
+
+def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:
+    """Render ``report`` and end the command: exit 0 when ``report.ok``, else 1 (problems found)."""
+    import typer
+
+    render(report, fmt)
+    raise typer.Exit(0 if report.ok else 1)
 
 
 def log(message: str) -> None:

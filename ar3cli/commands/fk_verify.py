@@ -7,10 +7,10 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
+from ar3cli.errors import UserError
 from ar3cli.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
                             load_from_options)
-from ar3cli.output import OutputFormat, Report, Table, log, render
+from ar3cli.output import OutputFormat, Report, Table, finish, log
 
 SamplesOption = Annotated[int, typer.Option("--samples", "-n", help="Random configurations to compare.")]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
@@ -118,8 +118,7 @@ def fk_verify(
     verdict = "PASS" if passed else "FAIL"
     lines.append(f"{verdict}: max position error {max_position:.3g} m (tolerance {tolerance_m:g}), max orientation "
                  f"error {max_orientation:.3g} rad (tolerance {tolerance_rad:g}); {samples} samples, seed {seed}")
-    render(Report(data=data, tables=[link_table, *dh_tables], lines=lines, ok=passed), format)
-    raise typer.Exit(EXIT_OK if passed else EXIT_PROBLEMS)
+    finish(Report(data=data, tables=[link_table, *dh_tables], lines=lines, ok=passed), format)
 
 
 def _configuration(values: dict[str, float]) -> str:

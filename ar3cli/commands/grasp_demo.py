@@ -9,9 +9,9 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
+from ar3cli.errors import UserError
 from ar3cli.options import FormatOption, SeedOption
-from ar3cli.output import OutputFormat, Report, Table, log, render
+from ar3cli.output import OutputFormat, Report, Table, finish, log
 
 TARGET_RATE = 0.95
 """--trials exits 1 below this success rate (the issue's target on the default region)."""
@@ -55,8 +55,7 @@ def grasp_demo(
 
         outcome = run_trials(seed, trials, settings, progress=progress if format is OutputFormat.text else None)
         ok = outcome.success_rate >= TARGET_RATE
-        render(trials_report(outcome, ok), format)
-        raise typer.Exit(EXIT_OK if ok else EXIT_PROBLEMS)
+        finish(trials_report(outcome, ok), format)
 
     recorder = None
     if record is not None:
@@ -71,8 +70,7 @@ def grasp_demo(
         frames = recorder.write(record)
         data["record"] = {"path": str(record), "frames": frames}
         lines.append(f"recorded {frames} frames to {record}")
-    render(single_report(result, data, lines), format)
-    raise typer.Exit(EXIT_OK if result.success else EXIT_PROBLEMS)
+    finish(single_report(result, data, lines), format)
 
 
 def single_report(result: Any, data: dict[str, Any], extra_lines: list[str]) -> Report:

@@ -2,11 +2,9 @@
 
 from __future__ import annotations
 
-import typer
 
-from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS
 from ar3cli.options import FormatOption
-from ar3cli.output import OutputFormat, Report, Table, render
+from ar3cli.output import OutputFormat, Report, Table, finish
 
 
 def install_check(format: FormatOption = OutputFormat.text) -> None:
@@ -24,6 +22,5 @@ def install_check(format: FormatOption = OutputFormat.text) -> None:
     failed = sum(c.status == "fail" for c in checks)
     warned = sum(c.status == "warn" for c in checks)
     verdict = "ready" if ok else "NOT ready"
-    render(Report(data={"ok": ok, "checks": [c.to_dict() for c in checks]}, tables=[table],
+    finish(Report(data={"ok": ok, "checks": [c.to_dict() for c in checks]}, tables=[table],
                   lines=[f"{verdict}: {len(checks)} checks, {failed} failed, {warned} warnings"], ok=ok), format)
-    raise typer.Exit(EXIT_OK if ok else EXIT_PROBLEMS)

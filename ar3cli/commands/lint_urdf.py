@@ -4,14 +4,14 @@ from __future__ import annotations
 
 import enum
 import os
-import sys
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
+from ar3cli.errors import UserError
 from ar3cli.options import PackagePathOption, XacroArgOption
+from ar3cli.output import Report, Table, finish
 
 
 class LintFormat(str, enum.Enum):
@@ -80,9 +80,9 @@ def lint_urdf(
     if not results:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     summary = summarize(results, threshold)
-    render_lint(results, summary, options, LintFormat(format))
-    failed = summary["failed"] and not exit_zero
-    raise typer.Exit(EXIT_PROBLEMS if failed else EXIT_OK)
+    report = render_lint(results, summary, options, LintFormat(format))
+    report.ok = report.ok or exit_zero
+    finish(report, "json" if LintFormat(format) in (LintFormat.json, LintFormat.sarif) else "text")
 
 
 def _split(items: list[str] | None) -> list[str]:
@@ -97,34 +97,31 @@ def summary_line(summary: dict) -> str:
             f"{summary['warning']} warnings, {summary['info']} info; {clean} clean (fail-on: {summary['fail_on']})")
 
 
-def render_lint(results, summary: dict, options, fmt: LintFormat) -> None:
-    """Print the findings in ``fmt`` (text and json through the shared output layer)."""
-    from ar3cli.output import Report, Table, emit_json, render
-
+def render_lint(results, summary: dict, options, fmt: LintFormat) -> Report:
+    """The lint Report in ``fmt``: text and json tables, SARIF as the JSON document, github
+    annotations and markdown as verbatim stdout text (github also appends the Markdown table to
+    ``$GITHUB_STEP_SUMMARY`` when set)."""
     findings = [f for result in results for f in result.findings]
+    data = {"files": [r.to_dict() for r in results], "findings": [f.to_dict() for f in findings], "summary": summary}
+    ok = not summary["failed"]
     if fmt is LintFormat.sarif:
         from ar3cli.output_sarif import sarif_document
 
-        emit_json(sarif_document(findings, options.rules()))
-    elif fmt is LintFormat.github:
+        return Report(data=sarif_document(findings, options.rules()), ok=ok)
+    if fmt in (LintFormat.github, LintFormat.markdown):
         from ar3cli.output_github import annotation, markdown_table
 
-        for finding in findings:
-            print(annotation(finding))
-        print(summary_line(summary))
+        table = markdown_table(findings, summary_line(summary))
+        if fmt is LintFormat.markdown:
+            return Report(data=data, text=table, ok=ok)
         step_summary = os.environ.get("GITHUB_STEP_SUMMARY")
         if step_summary:  # GitHub Actions: the reviewer sees the table on the run's summary page
             with open(step_summary, "a", encoding="utf-8") as handle:
-                handle.write(markdown_table(findings, summary_line(summary)))
-    elif fmt is LintFormat.markdown:
-        from ar3cli.output_github import markdown_table
-
-        sys.stdout.write(markdown_table(findings, summary_line(summary)))
-    else:
-        tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
-                        rows=[[f.location, f.rule, f.severity.value, f.message, f.hint] for f in result.findings],
-                        status_column="severity")
-                  for result in results if result.findings]
-        data = {"files": [r.to_dict() for r in results], "findings": [f.to_dict() for f in findings],
-                "summary": summary}
-        render(Report(data=data, tables=tables, lines=[summary_line(summary)], ok=not summary["failed"]), fmt.value)
+                handle.write(table)
+        annotations = "".join(annotation(finding) + "\n" for finding in findings)
+        return Report(data=data, text=annotations + summary_line(summary) + "\n", ok=ok)
+    tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
+                    rows=[[f.location, f.rule, f.severity.value, f.message, f.hint] for f in result.findings],
+                    status_column="severity")
+              for result in results if result.findings]
+    return Report(data=data, tables=tables, lines=[summary_line(summary)], ok=ok)

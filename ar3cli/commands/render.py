@@ -7,9 +7,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.errors import EXIT_OK
 from ar3cli.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, load_from_options
-from ar3cli.output import OutputFormat, Report, Table, render
+from ar3cli.output import OutputFormat, Report, Table, finish
 
 
 def render_command(
@@ -46,5 +45,4 @@ def render_command(
         tables.append(Table(title="links in contact (drawn red)", columns=["link a", "link b", "depth (m)"],
                             rows=[[a, b, d] for a, b, d in result.contacts], numeric_columns=("depth (m)",)))
     lines = [f"wrote {result.path} ({result.width}x{result.height})"]
-    render(Report(data=result.to_dict(), tables=tables, lines=lines), format)
-    raise typer.Exit(EXIT_OK)
+    finish(Report(data=result.to_dict(), tables=tables, lines=lines), format)

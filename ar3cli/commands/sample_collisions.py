@@ -8,9 +8,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.errors import EXIT_OK, UserError
+from ar3cli.errors import UserError
 from ar3cli.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
-from ar3cli.output import OutputFormat, Report, Table, console, render
+from ar3cli.output import OutputFormat, Report, Table, console, finish
 
 SamplesOption = Annotated[int, typer.Option("--samples", "-n", min=1,
                                             help="Uniform random configurations to check (MoveIt's default: 10000).")]
@@ -75,8 +75,8 @@ def sample_collisions(
 
         _write(png, heat_map_png(links, pairs, results, title=f"{model.name or model.path.name}: "
                                                              f"{samples} samples, seed {seed}"))
-    _render(model, results, links, pairs, warnings, run, samples, seed, jobs, always_threshold, format)
-    raise typer.Exit(EXIT_OK)
+    finish(_report(model, results, links, pairs, warnings, run, samples, seed, jobs, always_threshold, format),
+           format)
 
 
 def _load(path, package_path, xacro_arg):
@@ -166,7 +166,8 @@ def _write(path: Path, data: bytes) -> None:
     atomic_write(path, data)
 
 
-def _render(model, results, links, pairs, warnings, run, samples, seed, jobs, threshold, fmt) -> None:
+def _report(model, results, links, pairs, warnings, run, samples, seed, jobs, threshold, fmt) -> Report:
+    """The matrix as a Report: table, heat map and summary lines; always ok (findings don't fail the run)."""
     from ar3cli import collision_matrix as cm
 
     rate = samples / run["elapsed"] if run["elapsed"] > 0 else None
@@ -182,8 +183,7 @@ def _render(model, results, links, pairs, warnings, run, samples, seed, jobs, th
         "configs_per_second": rate, "elapsed_s": run["elapsed"],
     }
     if OutputFormat(fmt) is OutputFormat.json:
-        render(Report(data=data), fmt)
-        return
+        return Report(data=data)
     ordered = sorted(results, key=lambda r: (-r.fraction, cm.CATEGORIES.index(r.category), r.link_a, r.link_b))
     rows = []
     for result in ordered:
@@ -205,8 +205,8 @@ def _render(model, results, links, pairs, warnings, run, samples, seed, jobs, th
         f"{rate:,.0f} configurations/s with {jobs} job{'s' if jobs != 1 else ''}" if rate else "",
     ]
     lines += [f"{w.severity.value}: {w.message}" + (f" ({w.hint})" if w.hint else "") for w in warnings]
-    render(Report(data=data, tables=[table], renderables=[cm.heat_map(links, pairs, results)],
-                  lines=[line for line in lines if line]), fmt)
+    return Report(data=data, tables=[table], renderables=[cm.heat_map(links, pairs, results)],
+                  lines=[line for line in lines if line])
 
 
 def _tolerance() -> float:
