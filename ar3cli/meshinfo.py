@@ -106,7 +106,8 @@ def _binary_stl_count(data: bytes) -> int | None:
 def _stl_columns(data: bytes) -> tuple[Columns, bool] | None:
     count = _binary_stl_count(data)
     if count is None:
-        return _text_columns([v for match in _STL_VERTEX.findall(data) for v in match])
+        tokens = [v for match in _STL_VERTEX.findall(data) for v in match]
+        return _text_columns(tokens, b" ".join(tokens))
     # Gather the 36 vertex bytes of each 50-byte record with strided copies of 16-bit words
     # (records are 2-byte aligned), then read them as float32: no per-triangle Python code.
     words = array("H", data[84:])
@@ -125,19 +126,19 @@ def _stl_columns(data: bytes) -> tuple[Columns, bool] | None:
 
 def _obj_columns(data: bytes) -> tuple[Columns, bool] | None:
     rows = _OBJ_VERTEX.findall(b"\n" + data)
-    tokens = b" ".join(rows).split()
+    text = b" ".join(rows)
+    tokens = text.split()
     # Three per line is the usual "v x y z" (a malformed file mixing two- and four-number lines
     # could total three per line too, and be misread like the loaders misread it).
     if len(tokens) != 3 * len(rows):  # x y z may be followed by w, or by r g b: keep the first three
         tokens = [value for row in map(bytes.split, rows) if len(row) >= 3 for value in row[:3]]
-    return _text_columns(tokens)
+    return _text_columns(tokens, text)
 
 
-def _text_columns(tokens: list[bytes]) -> tuple[Columns, bool]:
-    """Columns of x y z numbers written as text (three tokens per vertex)."""
+def _text_columns(tokens: list[bytes], text: bytes) -> tuple[Columns, bool]:
+    """Columns of x y z numbers written as text (three tokens per vertex) found in ``text``."""
     values = list(map(float, tokens))
-    joined = b" ".join(tokens)
-    may_be_nonfinite = b"n" in joined or b"N" in joined  # only "nan" and "inf" have an n
+    may_be_nonfinite = b"n" in text or b"N" in text  # only "nan" and "inf" have an n
     return (values[0::3], values[1::3], values[2::3]), may_be_nonfinite
 
 
