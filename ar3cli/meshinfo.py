@@ -125,7 +125,10 @@ def _stl_columns(data: bytes) -> tuple[Columns, bool] | None:
 
 
 def _obj_columns(data: bytes) -> tuple[Columns, bool] | None:
-    rows = _OBJ_VERTEX.findall(b"\n" + data)
+    rows = _OBJ_VERTEX.findall(data)
+    if data[:2] in (b"v ", b"v\t"):  # the pattern needs a newline before "v"; the first line has none
+        end = data.find(b"\n")
+        rows.insert(0, data[2:end if end >= 0 else len(data)])
     text = b" ".join(rows)
     tokens = text.split()
     # Three per line is the usual "v x y z" (a malformed file mixing two- and four-number lines

@@ -58,6 +58,9 @@ def test_obj_extra_columns_and_empty(tmp_path):
     obj = tmp_path / "c.obj"
     obj.write_text("# colours and w\r\nv 1 2 3 0.5 0.5 0.5\r\nv -1 -2 -3 1.0\r\nvn 0 0 9\r\nvt 7 7\r\nv 0 0 0\r\n")
     assert meshinfo.mesh_bounds(obj) == ((-1.0, -2.0, -3.0), (1.0, 2.0, 3.0))
+    single = tmp_path / "s.obj"
+    single.write_bytes(b"v 5 6 7")  # first line, no newline at all
+    assert meshinfo.mesh_bounds(single) == ((5.0, 6.0, 7.0), (5.0, 6.0, 7.0))
     empty = tmp_path / "e.obj"
     empty.write_text("# nothing\nvn 0 0 1\n")
     assert meshinfo.mesh_bounds(empty) is None

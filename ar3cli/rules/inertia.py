@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from functools import lru_cache
 
 from ar3cli.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 from ar3cli.tensor_math import is_positive_definite, satisfies_triangle_inequality, symmetric_eigenvalues
@@ -19,7 +20,9 @@ def _moving_links(model) -> dict[str, object]:
     return {joint.child: joint for joint in model.joints if joint.moves and joint.child}
 
 
-def _moments(tensor) -> tuple[float, float, float]:
+@lru_cache(maxsize=4096)
+def _moments(tensor: tuple[float, ...]) -> tuple[float, float, float]:
+    """Principal moments of an (ixx, ixy, ixz, iyy, iyz, izz) tensor; cached, as I004, I005 and I007 all ask."""
     ixx, ixy, ixz, iyy, iyz, izz = tensor
     return symmetric_eigenvalues(((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz)))
 
