@@ -13,9 +13,10 @@ Conventions (the same as URDF ``<inertial>``):
 * ``rpy`` angles follow URDF: fixed-axis roll about x, then pitch about y, then yaw about
   z, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
 
-The functions are pure numpy so that the linter can use them without importing pybullet
-or trimesh. Mesh-based mass properties belong in a separate function that returns the
-same ``MassProperties`` type.
+The functions use numpy but not pybullet or trimesh. The 3x3 eigenvalue and rotation
+formulas live in :mod:`ar3cli.tensor_math` (plain Python, so that the linter need not import
+numpy); the functions here delegate to them and return numpy arrays. Mesh-based mass
+properties belong in a separate function that returns the same ``MassProperties`` type.
 """
 
 from __future__ import annotations
@@ -26,6 +27,8 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+from ar3cli import tensor_math
 
 __all__ = [
     "MassProperties",
@@ -133,14 +136,7 @@ def sphere(radius: float, mass: float | None = None, density: float | None = Non
 
 def rpy_to_matrix(rpy: ArrayLike) -> np.ndarray:
     """Rotation matrix of URDF roll-pitch-yaw angles: ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``."""
-    roll, pitch, yaw = np.asarray(rpy, dtype=float).reshape(3)
-    cr, sr = math.cos(roll), math.sin(roll)
-    cp, sp = math.cos(pitch), math.sin(pitch)
-    cy, sy = math.cos(yaw), math.sin(yaw)
-    rx = np.array([[1.0, 0.0, 0.0], [0.0, cr, -sr], [0.0, sr, cr]])
-    ry = np.array([[cp, 0.0, sp], [0.0, 1.0, 0.0], [-sp, 0.0, cp]])
-    rz = np.array([[cy, -sy, 0.0], [sy, cy, 0.0], [0.0, 0.0, 1.0]])
-    return rz @ ry @ rx
+    return np.array(tensor_math.rpy_to_matrix(np.asarray(rpy, dtype=float).reshape(3)))
 
 
 def transformed(mp: MassProperties, xyz: ArrayLike = (0.0, 0.0, 0.0), rpy: ArrayLike = (0.0, 0.0, 0.0)) -> MassProperties:
@@ -184,27 +180,25 @@ def scaled_to_mass(mp: MassProperties, mass: float) -> MassProperties:
     return MassProperties(mass, mp.com, mp.inertia * (mass / mp.mass))
 
 
+def _matrix(inertia: ArrayLike) -> np.ndarray:
+    return np.asarray(inertia, dtype=float).reshape(3, 3)
+
+
 def principal_moments(inertia: ArrayLike) -> np.ndarray:
     """Eigenvalues of the (symmetrised) tensor, ascending.
 
     They do not depend on the frame's orientation, which makes them the right thing to
     compare and to check physical validity on.
     """
-    tensor = np.asarray(inertia, dtype=float).reshape(3, 3)
-    return np.linalg.eigvalsh(0.5 * (tensor + tensor.T))
+    return np.array(tensor_math.symmetric_eigenvalues(_matrix(inertia)))
 
 
 def is_positive_definite(inertia: ArrayLike) -> bool:
     """True when every principal moment is strictly positive (a physical body)."""
-    return bool(np.all(principal_moments(inertia) > 0.0))
+    return tensor_math.is_positive_definite(_matrix(inertia))
 
 
 def satisfies_triangle_inequality(inertia: ArrayLike, tol: float = 1e-12) -> bool:
-    """True when each principal moment is at most the sum of the other two (+ ``tol``).
-
-    Every real mass distribution satisfies ``I_a + I_b >= I_c``; a tensor that violates
-    it cannot come from any body, and physics engines may become unstable with it.
-    ``tol`` absorbs rounding for thin shapes, where equality holds exactly.
-    """
-    a, b, c = principal_moments(inertia)
-    return bool(a + b + tol >= c and a + c + tol >= b and b + c + tol >= a)
+    """True when each principal moment is at most the sum of the other two (+ ``tol``); see
+    :func:`ar3cli.tensor_math.satisfies_triangle_inequality`."""
+    return tensor_math.satisfies_triangle_inequality(_matrix(inertia), tol)

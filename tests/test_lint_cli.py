@@ -200,19 +200,24 @@ def test_directory_named_like_a_file_and_missing_paths(cli, tmp_path):
     assert none.code == 2 and "no .urdf or .xacro files" in none.stderr
 
 
-def test_static_lint_does_not_import_pybullet_or_trimesh(tmp_path):
+def test_static_lint_does_not_import_numpy_pybullet_or_trimesh(tmp_path, pybullet_data_dir):
+    """The pre-commit path stays light: the Franka Panda's 18 OBJ meshes and 11 tensors without numpy."""
     import subprocess
     import sys
 
     from tests.conftest import REPO
 
     (tmp_path / "r.urdf").write_text(arm())
+    files = [str(tmp_path / "r.urdf"), str(pybullet_data_dir / "franka_panda" / "panda.urdf")]
     code = ("import sys\nfrom ar3cli.cli import main\n"
-            f"try:\n    main(['lint-urdf', {str(tmp_path / 'r.urdf')!r}])\nexcept SystemExit:\n    pass\n"
-            "print(sorted(m for m in ('pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")
+            f"try:\n    main(['lint-urdf', '--format', 'json', *{files!r}])\nexcept SystemExit:\n    pass\n"
+            "from ar3cli.meshinfo import _mesh_bounds\nprint(_mesh_bounds.cache_info().currsize)\n"
+            "print(sorted(m for m in ('numpy', 'pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO,
                          env={"PYTHONPATH": str(REPO), "NO_COLOR": "1", "PATH": "/usr/bin:/bin"})
-    assert out.stdout.strip().splitlines()[-1] == "[]", out.stderr
+    doc, meshes_read, modules = out.stdout.strip().rsplit("\n", 2)
+    assert modules == "[]", out.stderr
+    assert json.loads(doc)["summary"]["files"] == 2 and meshes_read == "18"  # all 18 panda meshes were read
 
 
 def test_sim_rules_run_only_with_sim(cli, write_urdf):

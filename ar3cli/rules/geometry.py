@@ -2,13 +2,16 @@
 
 from __future__ import annotations
 
-import itertools
+import math
 from collections.abc import Iterator
 from pathlib import Path
 
-import numpy as np
-
 from ar3cli.rules.base import LINK_INERTIAL, Hit, robot, rule
+from ar3cli.tensor_math import rpy_to_matrix
+
+Vector = tuple[float, float, float]
+Box = tuple[Vector, Vector]
+"""An axis-aligned box: (min corner, max corner)."""
 
 PYBULLET_MESH_FORMATS = (".stl", ".obj", ".dae")
 """What PyBullet's URDF importer loads (anything else: "invalid mesh filename extension")."""
@@ -20,35 +23,41 @@ FLAT_RATIO = 0.01
 """Meshes whose smallest extent is below this fraction of the largest are planes (ground, walls)."""
 
 
-def shape_bounds(shape) -> tuple[np.ndarray, np.ndarray] | None:
-    """Axis-aligned box of one visual/collision shape in its link's frame, or None if unknown."""
+def shape_bounds(shape) -> Box | None:
+    """Axis-aligned box of one visual/collision shape in its link's frame, or None if unknown.
+
+    The shape's own box (centre ``c``, half-extents ``h``) moved by its origin ``(xyz, R)`` is
+    centred on ``R c + xyz`` with half-extents ``|R| h``: the box around its 8 rotated corners.
+    """
     geometry = shape.geometry
     params = geometry.params
-    half: np.ndarray | None = None
-    centre = np.zeros(3)
+    half: Vector | None = None
+    centre: Vector = (0.0, 0.0, 0.0)
     if geometry.kind == "box" and params.get("size"):
-        half = np.abs(np.array(params["size"], dtype=float)) / 2
+        half = tuple(abs(float(v)) / 2 for v in params["size"])  # type: ignore[assignment]
     elif geometry.kind in ("cylinder", "capsule") and params.get("radius") is not None \
             and params.get("length") is not None:
         r, length = abs(params["radius"]), abs(params["length"])
-        half = np.array([r, r, length / 2 + (r if geometry.kind == "capsule" else 0.0)])
+        half = (r, r, length / 2 + (r if geometry.kind == "capsule" else 0.0))
     elif geometry.kind == "sphere" and params.get("radius") is not None:
-        half = np.full(3, abs(params["radius"]))
+        half = (abs(params["radius"]),) * 3
     elif geometry.kind == "mesh":
         scaled = scaled_mesh_bounds(geometry)
         if scaled is None:
             return None
-        centre, half = (scaled[0] + scaled[1]) / 2, (scaled[1] - scaled[0]) / 2
-    if half is None or not np.all(np.isfinite(half)):
+        low, high = scaled
+        centre = tuple((a + b) / 2 for a, b in zip(low, high))  # type: ignore[assignment]
+        half = tuple((b - a) / 2 for a, b in zip(low, high))  # type: ignore[assignment]
+    if half is None or not all(map(math.isfinite, half)):
         return None
-    from ar3cli.mass_properties import rpy_to_matrix
+    rotation = rpy_to_matrix(shape.origin.rpy)
+    world_centre = [sum(r * c for r, c in zip(row, centre)) + t for row, t in zip(rotation, shape.origin.xyz)]
+    world_half = [sum(abs(r) * h for r, h in zip(row, half)) for row in rotation]
+    return (tuple(c - h for c, h in zip(world_centre, world_half)),  # type: ignore[return-value]
+            tuple(c + h for c, h in zip(world_centre, world_half)))
 
-    corners = np.array([centre + half * np.array(signs) for signs in itertools.product((-1, 1), repeat=3)])
-    world = corners @ rpy_to_matrix(shape.origin.rpy).T + np.array(shape.origin.xyz)
-    return world.min(axis=0), world.max(axis=0)
 
-
-def scaled_mesh_bounds(geometry) -> tuple[np.ndarray, np.ndarray] | None:
+def scaled_mesh_bounds(geometry) -> Box | None:
     """The mesh's box in the shape frame (file bounds times scale), or None when it cannot be read."""
     from ar3cli.meshinfo import mesh_bounds
 
@@ -59,16 +68,22 @@ def scaled_mesh_bounds(geometry) -> tuple[np.ndarray, np.ndarray] | None:
     bounds = mesh_bounds(resolution.path)
     if bounds is None:
         return None
-    a, b = bounds[0] * np.array(scale), bounds[1] * np.array(scale)
-    return np.minimum(a, b), np.maximum(a, b)
+    a = [v * s for v, s in zip(bounds[0], scale)]
+    b = [v * s for v, s in zip(bounds[1], scale)]
+    return tuple(map(min, a, b)), tuple(map(max, a, b))  # type: ignore[return-value]
 
 
-def link_bounds(link) -> tuple[np.ndarray, np.ndarray] | None:
-    """Box around the link's collision shapes (visual shapes when it has no collision)."""
+def link_bounds(link) -> Box | None:
+    """Box around the link's collision shapes (visual shapes when it has no collision).
+
+    None when no shape has a known box, or when one is placed at a non-finite origin (nan/inf:
+    F007 reports the number; a box built from it would mean nothing).
+    """
     boxes = [b for b in (shape_bounds(s) for s in (link.collisions or link.visuals)) if b is not None]
-    if not boxes:
+    if not boxes or not all(math.isfinite(v) for box in boxes for corner in box for v in corner):
         return None
-    return np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
+    lows, highs = zip(*boxes)
+    return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]
 
 
 def _meshes(ctx):
@@ -165,12 +180,14 @@ def mesh_units(ctx) -> Iterator[Hit]:
         bounds = scaled_mesh_bounds(geometry)
         if bounds is None:
             continue
-        extent = bounds[1] - bounds[0]
+        extent = [b - a for a, b in zip(*bounds)]
+        if any(map(math.isnan, extent)):
+            continue  # a nan scale: F007 reports it
         key = (str(geometry.resolution.path), tuple(geometry.params.get("scale") or ()), link.name)
         if key in seen:
             continue
         seen.add(key)
-        largest, smallest = float(extent.max()), float(extent.min())
+        largest, smallest = max(extent), min(extent)
         shown = " x ".join(f"{e:.4g}" for e in extent)
         if largest > MAX_PLAUSIBLE_EXTENT and smallest > FLAT_RATIO * largest:
             yield Hit(f"link '{link.name}' mesh {geometry.filename} is {shown} m after scaling: millimetres?",

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterator
+from functools import lru_cache
 
 from ar3cli.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.tensor_math import is_positive_definite, satisfies_triangle_inequality, symmetric_eigenvalues
 
 IMPLAUSIBLE_FACTOR = 3.0
 """Radius of gyration above this many half-diagonals of the geometry's box cannot be real (see I007)."""
@@ -18,11 +20,11 @@ def _moving_links(model) -> dict[str, object]:
     return {joint.child: joint for joint in model.joints if joint.moves and joint.child}
 
 
-def _moments(tensor):
-    from ar3cli.mass_properties import principal_moments
-
+@lru_cache(maxsize=4096)
+def _moments(tensor: tuple[float, ...]) -> tuple[float, float, float]:
+    """Principal moments of an (ixx, ixy, ixz, iyy, iyz, izz) tensor; cached, as I004, I005 and I007 all ask."""
     ixx, ixy, ixz, iyy, iyz, izz = tensor
-    return principal_moments([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
+    return symmetric_eigenvalues(((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz)))
 
 
 def _finite(tensor) -> bool:
@@ -107,8 +109,6 @@ def _tensor_hits(ctx, test):
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="-0.01" iyz="0" izz="0.01"/></inertial>'),
       good=arm())
 def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
-    from ar3cli.mass_properties import is_positive_definite
-
     for link, inertial, moments in _tensor_hits(ctx, lambda inertial, _m: is_positive_definite(inertial.matrix())):
         yield Hit(f"link '{link.name}' inertia is not positive definite: principal moments {_fmt(moments)}",
                   inertial.element.find("inertia"))
@@ -122,8 +122,6 @@ def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/></inertial>'),
       good=arm())
 def inertia_triangle(ctx) -> Iterator[Hit]:
-    from ar3cli.mass_properties import satisfies_triangle_inequality
-
     def ok(inertial, moments) -> bool:
         return moments[0] <= 0 or satisfies_triangle_inequality(inertial.matrix(), tol=TRIANGLE_TOLERANCE * moments[-1])
 

@@ -1,0 +1,69 @@
+"""Mesh bounds read without numpy: real pybullet_data meshes against trimesh, and the edge cases."""
+
+from __future__ import annotations
+
+import math
+import struct
+
+import numpy as np
+import pytest
+
+from ar3cli import meshinfo
+
+
+def _binary_stl(triangles: list[list[tuple[float, float, float]]]) -> bytes:
+    records = b"".join(struct.pack("<12fH", 0, 0, 0, *(c for v in tri for c in v), 0) for tri in triangles)
+    return b"\0" * 80 + struct.pack("<I", len(triangles)) + records
+
+
+@pytest.mark.parametrize("relative", ["franka_panda/meshes/visual/link6.obj", "franka_panda/meshes/collision/link4.obj",
+                                      "kuka_iiwa/meshes/link_3.stl", "differential/diff_ring.stl",
+                                      "duck.obj"])
+def test_bounds_match_trimesh_on_real_meshes(pybullet_data_dir, relative):
+    import trimesh
+
+    path = pybullet_data_dir / relative
+    vertices = np.asarray(trimesh.load(str(path), force="mesh", process=False).vertices)
+    low, high = meshinfo.mesh_bounds(path)
+    np.testing.assert_allclose(low, vertices.min(axis=0), rtol=1e-15, atol=0)
+    np.testing.assert_allclose(high, vertices.max(axis=0), rtol=1e-15, atol=0)
+    assert all(isinstance(v, float) for v in (*low, *high))
+
+
+def test_large_binary_stl_numpy_path_agrees(pybullet_data_dir):
+    data = (pybullet_data_dir / "differential" / "diff_ring.stl").read_bytes()
+    columns, may_be_nonfinite = meshinfo._stl_columns(data)
+    assert not may_be_nonfinite
+    assert meshinfo._bounds(columns, False) == meshinfo._numpy_stl_bounds(data)
+
+
+def test_non_finite_vertices_are_ignored_whole(tmp_path):
+    nan, inf = math.nan, math.inf
+    triangles = [[(0, 0, 0), (1, 2, 3), (nan, 50, 50)], [(inf, -9, 0), (0.5, 0.5, -1), (0, 0, 0)]]
+    stl = tmp_path / "t.stl"
+    stl.write_bytes(_binary_stl(triangles))
+    expected = ((0.0, 0.0, -1.0), (1.0, 2.0, 3.0))  # (nan, 50, 50) and (inf, -9, 0) dropped entirely
+    assert meshinfo.mesh_bounds(stl) == expected
+    assert meshinfo._numpy_stl_bounds(stl.read_bytes()) == expected
+    obj = tmp_path / "t.obj"
+    obj.write_text("v 0 0 0\nv 1 2 3\nv nan 50 50\nv inf -9 0\nv 0.5 0.5 -1\nf 1 2 3\n")
+    assert meshinfo.mesh_bounds(obj) == expected
+    ascii_stl = tmp_path / "a.stl"
+    ascii_stl.write_text("solid s\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex NaN 9 9\n"
+                         "   vertex 1 2 3\n  endloop\n endfacet\nendsolid s\n")
+    assert meshinfo.mesh_bounds(ascii_stl) == ((0.0, 0.0, 0.0), (1.0, 2.0, 3.0))
+
+
+def test_obj_extra_columns_and_empty(tmp_path):
+    obj = tmp_path / "c.obj"
+    obj.write_text("# colours and w\r\nv 1 2 3 0.5 0.5 0.5\r\nv -1 -2 -3 1.0\r\nvn 0 0 9\r\nvt 7 7\r\nv 0 0 0\r\n")
+    assert meshinfo.mesh_bounds(obj) == ((-1.0, -2.0, -3.0), (1.0, 2.0, 3.0))
+    single = tmp_path / "s.obj"
+    single.write_bytes(b"v 5 6 7")  # first line, no newline at all
+    assert meshinfo.mesh_bounds(single) == ((5.0, 6.0, 7.0), (5.0, 6.0, 7.0))
+    empty = tmp_path / "e.obj"
+    empty.write_text("# nothing\nvn 0 0 1\n")
+    assert meshinfo.mesh_bounds(empty) is None
+    junk = tmp_path / "j.obj"
+    junk.write_text("v 1 two 3\n")
+    assert meshinfo.mesh_bounds(junk) is None
