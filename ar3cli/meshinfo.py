@@ -5,7 +5,8 @@ and trimesh ~0.5 s, more than reading the meshes of a typical robot (the Franka 
 files, 52k vertices, take ~25 ms), so a static lint never imports either for them. Binary STL
 files of at least :data:`NUMPY_MIN_BYTES` are read with numpy, where its import pays for
 itself. Other formats (COLLADA .dae, ...) fall back to trimesh, imported only then. Results are
-cached per path for the process (bulk lints share meshes between models).
+cached per path for the process (bulk lints share meshes between models) and on disk between runs
+(:mod:`ar3cli.cache`, keyed by path, modification time and size).
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ from array import array
 from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
+
+from ar3cli.cache import MISSING, FileFacts
 
 LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 MAX_MESH_BYTES = 200 * 1024 * 1024
@@ -34,6 +37,9 @@ _OBJ_VERTEX = re.compile(rb"\nv[ \t]([^\n]*)")
 _STL_VERTEX = re.compile(rb"vertex\s+(\S+)\s+(\S+)\s+(\S+)")
 _STL_RECORD = 50
 """Bytes per binary STL triangle: normal (3 float32), 3 vertices (9 float32), attribute (uint16)."""
+
+
+_DISK_CACHE = FileFacts("mesh-bounds", version=1)
 
 
 def is_lfs_pointer(path: Path) -> bool:
@@ -54,7 +60,12 @@ def mesh_bounds(path: Path) -> Bounds | None:
         stat = path.stat()
     except OSError:
         return None
-    return _mesh_bounds(path, stat.st_mtime_ns, stat.st_size)
+    stored = _DISK_CACHE.get(path, stat)
+    if stored is not MISSING:
+        return (tuple(stored[0]), tuple(stored[1])) if stored else None  # type: ignore[return-value]
+    bounds = _mesh_bounds(path, stat.st_mtime_ns, stat.st_size)
+    _DISK_CACHE.put(path, stat, [list(bounds[0]), list(bounds[1])] if bounds else None)
+    return bounds
 
 
 @lru_cache(maxsize=1024)

@@ -41,6 +41,8 @@ class Table:
     caption: str = ""
     status_column: str | None = None
     numeric_columns: tuple[str, ...] = ()
+    nowrap_columns: tuple[str, ...] = ()
+    """Columns a terminal table must not fold (e.g. ``path:line:col``, which editors make clickable)."""
 
 
 @dataclass
@@ -83,20 +85,46 @@ def format_cell(value: Any) -> str:
     return str(value)
 
 
+def plain_table(table: Table) -> str:
+    """An ASCII table, one line per row and no wrapping: what pipes, CI logs and grep want.
+
+    Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's 659 lint findings);
+    off a terminal nobody sees its wrapping, so this is a plain, fast formatter.
+    """
+    rows = [[format_cell(value).replace("\n", " ") for value in row] for row in table.rows]
+    widths = [max([len(column), *(len(row[index]) for row in rows)]) for index, column in enumerate(table.columns)]
+    numeric = [column in table.numeric_columns for column in table.columns]
+
+    def line(cells: list[str]) -> str:
+        return "| " + " | ".join(cell.rjust(width) if right else cell.ljust(width)
+                                 for cell, width, right in zip(cells, widths, numeric)) + " |"
+
+    rule = "+" + "+".join("-" * (width + 2) for width in widths) + "+"
+    out = [table.title] if table.title else []
+    out += [rule, line(list(table.columns)), rule, *(line(row) for row in rows), rule]
+    if table.caption:
+        out.append(table.caption)
+    return "\n".join(out) + "\n"
+
+
 def render_table(table: Table, out=None) -> None:
-    """Print one :class:`Table` through rich."""
+    """Print one :class:`Table`: through rich on a terminal, as :func:`plain_table` elsewhere."""
+    out = out or console()
+    if not out.is_terminal:
+        out.file.write(plain_table(table))
+        out.file.flush()
+        return
     from rich import box
     from rich.table import Table as RichTable
     from rich.text import Text
 
-    out = out or console()
     plain = out.no_color
     rich_table = RichTable(title=table.title or None, caption=table.caption or None,
                            box=box.ASCII2 if plain else box.ROUNDED, title_justify="left",
                            caption_justify="left", header_style="" if plain else "bold")
     for column in table.columns:
         rich_table.add_column(column, justify="right" if column in table.numeric_columns else "left",
-                              overflow="fold")
+                              overflow="fold", no_wrap=column in table.nowrap_columns)
     status_index = table.columns.index(table.status_column) if table.status_column in table.columns else -1
     for row in table.rows:
         cells = []

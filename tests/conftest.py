@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import os
 import subprocess
+import tempfile
 import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+
+os.environ.setdefault("AR3CLI_CACHE_DIR", tempfile.mkdtemp(prefix="ar3cli-test-cache-"))
+"""Tests (and the CLI processes they start) never write to the user's ~/.cache."""
 
 REPO = Path(__file__).resolve().parents[1]
 ASSETS = REPO / "assets"

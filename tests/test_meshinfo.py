@@ -67,3 +67,37 @@ def test_obj_extra_columns_and_empty(tmp_path):
     junk = tmp_path / "j.obj"
     junk.write_text("v 1 two 3\n")
     assert meshinfo.mesh_bounds(junk) is None
+
+
+def test_disk_cache_reuses_and_invalidates(tmp_path, monkeypatch):
+    """Bounds survive the process (keyed by path, mtime, size); an edited mesh is read again."""
+    import os
+
+    from ar3cli import cache, meshinfo
+
+    monkeypatch.setenv("AR3CLI_CACHE_DIR", str(tmp_path / "cache"))
+    mesh = tmp_path / "m.obj"
+    mesh.write_text("v 0 0 0\nv 1 2 3\n")
+
+    def fresh_bounds():
+        meshinfo._DISK_CACHE = cache.FileFacts("mesh-bounds", version=1)  # a new process, in effect
+        meshinfo._mesh_bounds.cache_clear()
+        return meshinfo.mesh_bounds(mesh)
+
+    assert fresh_bounds() == ((0.0, 0.0, 0.0), (1.0, 2.0, 3.0))
+    meshinfo._DISK_CACHE.save()
+    stored = next((tmp_path / "cache").glob("mesh-bounds-v1.json"))
+    import json
+
+    entries = json.loads(stored.read_text())
+    (key,) = entries
+    assert key.startswith(str(mesh.resolve()))
+    stored.write_text(json.dumps({key: [[9, 9, 9], [9, 9, 9]]}))  # plant a value only the disk knows
+    assert fresh_bounds() == ((9, 9, 9), (9, 9, 9))  # answered from disk, the mesh was not read
+    mesh.write_text("v 0 0 0\nv 5 5 5\n")
+    os.utime(mesh, ns=(1, 10**18))
+    assert fresh_bounds() == ((0.0, 0.0, 0.0), (5.0, 5.0, 5.0))  # edited: read again
+    stored.write_text("{ not json")
+    assert fresh_bounds() == ((0.0, 0.0, 0.0), (5.0, 5.0, 5.0))  # a damaged cache is ignored
+    monkeypatch.setenv("AR3CLI_NO_CACHE", "1")
+    assert cache.cache_dir() is None

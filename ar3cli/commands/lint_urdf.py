@@ -122,6 +122,6 @@ def render_lint(results, summary: dict, options, fmt: LintFormat) -> Report:
         return Report(data=data, text=annotations + summary_line(summary) + "\n", ok=ok)
     tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
                     rows=[[f.location, f.rule, f.severity.value, f.message, f.hint] for f in result.findings],
-                    status_column="severity")
+                    status_column="severity", nowrap_columns=("location",))
               for result in results if result.findings]
     return Report(data=data, tables=tables, lines=[summary_line(summary)], ok=ok)

@@ -1,0 +1,91 @@
+"""A small on-disk cache of facts about files that are slow to compute (mesh bounding boxes).
+
+A pre-commit hook or a CI step lints the same meshes again and again; reading 50 MB of OBJ and
+STL text takes longer than all the rules together. Facts are keyed by the file's absolute path,
+modification time (ns) and size, so an edited mesh is read again. The cache is one JSON file per
+kind of fact, written atomically at exit and only when something new was learnt; a corrupt or
+unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
+``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
+"""
+
+from __future__ import annotations
+
+import atexit
+import json
+import os
+from pathlib import Path
+from typing import Any
+
+MAX_ENTRIES = 20_000
+"""Beyond this many entries the oldest half is dropped when saving (the cache stays small)."""
+
+MISSING = object()
+
+
+def cache_dir() -> Path | None:
+    """Where caches live, or None when caching is turned off."""
+    if os.environ.get("AR3CLI_NO_CACHE"):
+        return None
+    if os.environ.get("AR3CLI_CACHE_DIR"):
+        return Path(os.environ["AR3CLI_CACHE_DIR"])
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "ar3cli"
+
+
+class FileFacts:
+    """Facts (JSON values) about files, persisted in ``<cache dir>/<name>.json``."""
+
+    def __init__(self, name: str, version: int) -> None:
+        self.name = name
+        self.version = version
+        self._entries: dict[str, Any] | None = None
+        self._dirty = False
+
+    def _key(self, path: Path, stat: os.stat_result) -> str:
+        return f"{path.resolve()}|{stat.st_mtime_ns}|{stat.st_size}"
+
+    def _file(self) -> Path | None:
+        folder = cache_dir()
+        return folder / f"{self.name}-v{self.version}.json" if folder else None
+
+    def _load(self) -> dict[str, Any]:
+        if self._entries is None:
+            self._entries = {}
+            location = self._file()
+            if location is not None:
+                try:
+                    loaded = json.loads(location.read_text(encoding="utf-8"))
+                    if isinstance(loaded, dict):
+                        self._entries = loaded
+                except (OSError, ValueError):
+                    pass  # no cache yet, or a damaged one: start afresh
+        return self._entries
+
+    def get(self, path: Path, stat: os.stat_result) -> Any:
+        """The stored fact for this version of ``path``, or :data:`MISSING`."""
+        return self._load().get(self._key(path, stat), MISSING)
+
+    def put(self, path: Path, stat: os.stat_result, value: Any) -> None:
+        """Remember ``value`` (JSON-serialisable) for this version of ``path``; saved at exit."""
+        entries = self._load()
+        entries[self._key(path, stat)] = value
+        if not self._dirty and self._file() is not None:
+            atexit.register(self.save)
+        self._dirty = True
+
+    def save(self) -> None:
+        """Write the cache atomically if it changed; failures are silent (a cache is optional)."""
+        location = self._file()
+        if not self._dirty or location is None or self._entries is None:
+            return
+        entries = self._entries
+        if len(entries) > MAX_ENTRIES:
+            entries = dict(list(entries.items())[len(entries) // 2:])
+        try:
+            from ar3cli.atomic import atomic_write
+
+            location.parent.mkdir(parents=True, exist_ok=True)
+            atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"))
+            self._dirty = False
+        except Exception:  # noqa: BLE001 - a read-only home must never break a lint
+            pass
