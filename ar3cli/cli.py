@@ -57,10 +57,42 @@ app.command("fix-continuous")(fix_continuous)
 app.command("sample-collisions")(sample_collisions)
 
 
+def _click_exceptions() -> tuple[type, type]:
+    """(UsageError, NoArgsIsHelpError) of whichever click typer uses (recent typer vendors its own)."""
+    import importlib
+
+    for name in ("typer._click.exceptions", "click.exceptions"):
+        try:
+            module = importlib.import_module(name)
+        except ImportError:
+            continue
+        no_args = getattr(module, "NoArgsIsHelpError", None) or type("NoArgsIsHelpError", (Exception,), {})
+        return module.UsageError, no_args
+    raise ImportError("neither typer's vendored click nor click is installed")  # pragma: no cover
+
+
 def main(argv: list[str] | None = None) -> None:
-    """Console entry point: run the app and turn UserError into a one-line message + exit code."""
+    """Console entry point: run the app; errors become one line on stderr and an exit code.
+
+    Usage errors (a bad option value, a missing argument) are shortened from click's multi-line
+    box to ``ar3cli: error: <what> (see 'ar3cli COMMAND --help')`` with exit code 2, like every
+    other input error.
+    """
+    usage_error, no_args = _click_exceptions()
     try:
-        app(args=argv, prog_name="ar3cli")
+        code = app(args=argv, prog_name="ar3cli", standalone_mode=False)
+        sys.exit(code if isinstance(code, int) else 0)
+    except no_args as exc:  # `ar3cli` alone, or a group without a command: show the help
+        exc.show()
+        sys.exit(EXIT_USAGE)
+    except usage_error as exc:
+        command = exc.ctx.command_path if getattr(exc, "ctx", None) is not None else "ar3cli"
+        message = " ".join(exc.format_message().replace("Value error, ", "").split())
+        print(f"ar3cli: error: {message} (see '{command} --help')", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
+    except typer.Abort:
+        print("ar3cli: interrupted", file=sys.stderr)
+        sys.exit(130)
     except UserError as exc:
         print(f"ar3cli: error: {exc.message}", file=sys.stderr)
         sys.exit(exc.exit_code)

@@ -14,10 +14,19 @@ def test_version(cli):
     assert result.code == 0 and result.stdout.startswith("ar3cli ")
 
 
-def test_unknown_command_is_usage_error(cli):
-    result = cli("no-such-command")
-    assert result.code == 2
-    assert "Traceback" not in result.stderr
+def test_usage_errors_are_one_line_with_exit_2(cli):
+    for args in (["no-such-command"], ["lint-urdf"], ["lint-urdf", "x.urdf", "--format", "xml"],
+                 ["sample-collisions", "x.urdf", "--samples", "0"], ["lint-urdf", "--bogus", "x.urdf"]):
+        result = cli(*args)
+        assert result.code == 2, args
+        assert result.stdout == ""
+        (line,) = result.stderr.strip().splitlines()
+        assert line.startswith("ar3cli: error: ") and "--help" in line and "Value error" not in line
+
+
+def test_no_arguments_shows_help(cli):
+    result = cli()
+    assert result.code == 2 and "Usage:" in result.stdout and "lint-urdf" in result.stdout
 
 
 def test_help_texts_survive_markdown_rendering():
