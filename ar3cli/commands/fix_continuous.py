@@ -7,13 +7,12 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.fix_inertia import CheckOption, DiffOption, OutputOption, PathsArgument
-from ar3cli.options import FormatOption, PackagePathOption
+from ar3cli.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
 from ar3cli.output import OutputFormat
 
 
 def fix_continuous(
-    paths: PathsArgument,
+    paths: FixPathsArgument,
     limits_from: Annotated[Optional[Path], typer.Option(
         "--limits-from", metavar="JOINT_LIMITS_YAML",
         help="MoveIt joint_limits.yaml: joints with has_position_limits become revolute with its limits.")] = None,

@@ -2,23 +2,17 @@
 
 from __future__ import annotations
 
-from pathlib import Path
+import math
 from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.options import FormatOption, PackagePathOption
+from ar3cli.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
 from ar3cli.output import OutputFormat
-
-PathsArgument = Annotated[list[Path], typer.Argument(help=".urdf files to fix (xacro is refused).", show_default=False)]
-DiffOption = Annotated[bool, typer.Option("--diff", help="Print a unified diff and write nothing.")]
-CheckOption = Annotated[bool, typer.Option("--check", help="Write nothing; exit 1 when a change is needed.")]
-OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", help="Write the result to FILE instead of "
-                                                      "in place (one input only).", show_default=False)]
 
 
 def fix_inertia(
-    paths: PathsArgument,
+    paths: FixPathsArgument,
     links: Annotated[Optional[str], typer.Option("--links", help="Comma-separated links to recompute "
                                                  "(default: the links the linter flags).")] = None,
     all_links: Annotated[bool, typer.Option("--all", help="Recompute every link that has geometry.")] = False,
@@ -44,10 +38,10 @@ def fix_inertia(
     from ar3cli.fix_inertia_plan import InertiaOptions, make_fixer, parse_masses
     from ar3cli.fixing import run_fixer
 
-    if density is not None and not density > 0:
-        raise UserError(f"--density {density}: must be positive (kg/m^3, e.g. 1200 for PLA)")
-    if total_mass is not None and not total_mass > 0:
-        raise UserError(f"--total-mass {total_mass}: must be positive (kg)")
+    if density is not None and not 0 < density < math.inf:
+        raise UserError(f"--density {density}: must be a positive number (kg/m^3, e.g. 1200 for PLA)")
+    if total_mass is not None and not 0 < total_mass < math.inf:
+        raise UserError(f"--total-mass {total_mass}: must be a positive number (kg)")
     if links is not None and all_links:
         raise UserError("--links and --all exclude each other")
     names = [name.strip() for name in links.split(",") if name.strip()] if links is not None else None

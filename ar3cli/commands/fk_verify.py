@@ -9,10 +9,10 @@ import typer
 
 from ar3cli.errors import UserError
 from ar3cli.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
-                            load_from_options)
+                            load_from_options, samples_option)
 from ar3cli.output import OutputFormat, Report, Table, finish, log
 
-SamplesOption = Annotated[int, typer.Option("--samples", "-n", help="Random configurations to compare.")]
+SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
                                                   help="A DH table to check against the URDF (see docs).")]
 ToleranceMOption = Annotated[float, typer.Option("--tolerance-m", help="Largest position error that passes (m).")]
@@ -44,8 +44,6 @@ def fk_verify(
     from ar3cli import fk_compare
     from ar3cli.sim import Session
 
-    if samples < 1:
-        raise UserError(f"--samples must be at least 1, got {samples}")
     if not (tolerance_m > 0 and tolerance_rad > 0):
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
     model = load_from_options(path, package_path, xacro_arg)

@@ -31,7 +31,7 @@ class FailOn(str, enum.Enum):
 
 
 def lint_urdf(
-    paths: Annotated[list[Path], typer.Argument(help="URDF/xacro files, or folders searched for *.urdf and *.xacro.",
+    paths: Annotated[list[Path], typer.Argument(metavar="PATH", help="URDF/xacro files, or folders searched for *.urdf and *.xacro.",
                                                 show_default=False)],
     format: Annotated[LintFormat, typer.Option("--format", "-f", help="text (table), json, sarif (SARIF 2.1.0), "
                                                                       "github (workflow annotations) or markdown.")]

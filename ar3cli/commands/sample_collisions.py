@@ -9,12 +9,12 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.errors import UserError
-from ar3cli.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
+from ar3cli.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
+                            samples_option)
 from ar3cli.output import OutputFormat, Report, Table, console, finish
 
-SamplesOption = Annotated[int, typer.Option("--samples", "-n", min=1,
-                                            help="Uniform random configurations to check (MoveIt's default: 10000).")]
-SeedOption = Annotated[int, typer.Option("--seed", help="Random seed; the same seed gives the same matrix.")]
+SamplesOption = Annotated[int, samples_option("Uniform random configurations to check (MoveIt's default: 10000).",
+                                              most=10_000_000)]
 JobsOption = Annotated[int, typer.Option("--jobs", "-j", min=1,
                                          help="Worker processes (one PyBullet client each); counts are exact "
                                               "and identical for any number of jobs.")]
