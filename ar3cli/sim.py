@@ -31,7 +31,7 @@ from typing import Any
 
 from ar3cli.capture import capture_fds
 from ar3cli.errors import UserError
-from ar3cli.model import Joint, Model
+from ar3cli.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 Pose = tuple[tuple[float, float, float], tuple[float, float, float, float]]
 """(position xyz, quaternion xyzw) in the world frame."""
@@ -70,7 +70,8 @@ class JointRecord:
 
     @property
     def movable(self) -> bool:
-        return self.urdf_type in ("revolute", "continuous", "prismatic")
+        """A 1-DOF joint (:data:`~ar3cli.model.ACTUATED_JOINT_TYPES`): one position, one motor."""
+        return self.urdf_type in ACTUATED_JOINT_TYPES
 
     @property
     def continuous(self) -> bool:
