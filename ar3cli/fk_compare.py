@@ -63,16 +63,15 @@ class Comparison:
 
 
 def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
-    """Uniform samples within each driving joint's range (continuous: [-pi, pi)); mimic joints follow.
+    """Uniform samples of the driving joints (:mod:`ar3cli.sampling`); mimic joints follow.
 
     Ranges come from :meth:`ar3cli.sim.JointRecord.sample_range`, i.e. the URDF's limits.
     """
-    rng = np.random.default_rng(seed)
-    driving = [joint for joint in body.movable_joints if joint.urdf is None or joint.urdf.mimic is None
-               or model.joint(joint.urdf.mimic.joint) is None]
-    ranges = np.array([joint.sample_range() for joint in driving]).reshape(-1, 2)
-    values = rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, len(driving)))
-    names = [joint.name for joint in driving]
+    from ar3cli import sampling
+
+    space = sampling.joint_space(body)
+    values = sampling.sample_driving(space, count, seed)
+    names = list(space.driving_names)
     all_values = kinematics.driven_values(model, {n: values[:, i] for i, n in enumerate(names)}, count)
     return Samples(seed=seed, names=names, values=values, all_values=all_values)
 
