@@ -18,7 +18,8 @@ Two measured facts shape this module:
   what makes the merged counts identical for any number of jobs.
 - ``getContactPoints`` also reports points at small positive distance (up to ~4 mm on the panda) and
   faces that rest exactly on each other (distance ~1e-17). A pair counts as *colliding* only when it
-  penetrates deeper than :data:`CONTACT_TOLERANCE` (1 um).
+  penetrates deeper than :data:`~ar3cli.sim.PENETRATION_TOLERANCE` (1 um), the threshold lint-urdf's
+  P002 and render use too.
 
 Configurations are generated up front in the parent by :mod:`ar3cli.sampling` (only the driving
 joints are drawn from ``numpy.random.default_rng(seed)``; ``<mimic>`` joints follow), split
@@ -37,15 +38,17 @@ from pathlib import Path
 
 import numpy as np
 
+from ar3cli.adjacency import collision_links
 from ar3cli.errors import UserError
 from ar3cli.model import Model, load_model
 from ar3cli.sampling import JointSpace, joint_space, limit_configurations, sample_configurations
+from ar3cli.sim import PENETRATION_TOLERANCE
 
 __all__ = ["Checker", "JointSpace", "ModelSource", "collision_links", "count_collisions", "limit_configurations",
            "sample_configurations"]
 
-CONTACT_TOLERANCE = 1e-6
-"""m: a pair collides when its deepest contact point penetrates more than this."""
+CONTACT_TOLERANCE = PENETRATION_TOLERANCE
+"""m: a pair collides when its deepest contact point penetrates more than this (the shared constant)."""
 CONTACT_BREAKING_THRESHOLD = 1e-5
 """m: Bullet drops manifold points that drifted more than this; small, so teleports leave no stale points."""
 
@@ -60,12 +63,6 @@ class ModelSource:
 
     def load(self) -> Model:
         return load_model(self.path, self.package_paths or None, self.xacro_args or None)
-
-
-def collision_links(model: Model) -> list[str]:
-    """Links with at least one ``<collision>`` whose geometry parses, in file order."""
-    return [link.name for link in model.links
-            if any(shape.geometry.kind is not None for shape in link.collisions)]
 
 
 class Checker:

@@ -93,3 +93,10 @@ def test_fk_verify_passes_on_the_mimic_gripper(cli, gripper):
     result = cli("fk-verify", str(gripper), "-n", "20", "--format", "json")
     assert result.code == 0, result.stderr
     assert set(json.loads(result.stdout)["worst"]["configuration"]) == {"left"}
+
+
+def test_render_moves_the_mimic_with_its_source(cli, gripper, tmp_path):
+    result = cli("render", str(gripper), "-o", str(tmp_path / "g.png"), "--config", "left=0.015",
+                 "--width", "32", "--height", "32", "--format", "json")
+    assert result.code == 0, result.stderr
+    assert json.loads(result.stdout)["configuration"] == {"left": 0.015, "right": 0.015}
