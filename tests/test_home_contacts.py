@@ -62,3 +62,14 @@ def test_p002_looks_through_a_link_without_geometry(write_urdf):
     options = LintOptions(sim=True)
     findings = lint_file(write_urdf(text), options.rules(), options).findings
     assert not [f for f in findings if f.rule == "P002"]
+
+
+def test_p002_reports_a_shallow_overlap_in_micrometres(write_urdf):
+    """5 um deep is above the 1 um tolerance (resting faces are ~1e-16 m) and is printed in um, not '0.0 mm'."""
+    from ar3cli.lint import LintOptions, lint_file
+    from ar3cli.rules import REGISTRY
+
+    text = REGISTRY["P002"].bad.replace('<origin xyz="0 0 -0.25"/>', '<origin xyz="0 0 -0.100005"/>')
+    options = LintOptions(sim=True)
+    (finding,) = [f for f in lint_file(write_urdf(text), options.rules(), options).findings if f.rule == "P002"]
+    assert "'base' and 'tip'" in finding.message and "by 5.0 µm" in finding.message

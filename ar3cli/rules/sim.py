@@ -92,8 +92,13 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
         body.set_positions(_home(body))
         for a, b, depth in nonadjacent_collisions(body):
             link = ctx.model.link(b) or ctx.model.link(a)
-            yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.1f} mm at the home pose",
+            yield Hit(f"links '{a}' and '{b}' interpenetrate by {_depth_text(-depth)} at the home pose",
                       link.element if link else None)
+
+
+def _depth_text(depth: float) -> str:
+    """0.1 mm and deeper in mm, shallower in µm (a 4 µm overlap is not '0.0 mm')."""
+    return f"{depth * 1000:.1f} mm" if depth >= 1e-4 else f"{depth * 1e6:.1f} µm"
 
 
 @rule("P003", "sim-inertia-differs", "info", "PyBullet uses a different mass or inertia than the file",
