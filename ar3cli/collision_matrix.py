@@ -3,7 +3,8 @@
 Categories, in MoveIt's order of precedence (``compute_default_collisions.cpp``):
 
 1. ``adjacent``: joined by a joint, links without collision geometry being transparent (removed and
-   their neighbours joined), so parent and grandchild across a geometry-less link are adjacent.
+   their neighbours joined), so parent and grandchild across a geometry-less link are adjacent
+   (:func:`ar3cli.adjacency.adjacent_pairs`, shared with lint-urdf's P002 and render).
 2. ``default``: in contact at the home pose (0, or mid-range where 0 is outside the limits).
 3. ``always``: in contact in at least ``always_threshold`` (0.95) of the uniform samples.
 4. ``never``: never in contact, neither in the uniform samples nor in any limit configuration
@@ -23,8 +24,11 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
+from ar3cli.adjacency import adjacent_pairs, direct_parent_child
 from ar3cli.findings import Finding, Severity
 from ar3cli.model import Model
+
+__all__ = ["adjacent_pairs", "classify", "direct_parent_child", "findings", "srdf_bytes"]
 
 CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
 DISABLED = ("adjacent", "default", "always", "never")
@@ -48,40 +52,6 @@ def zero_success_upper_bound(trials: int, confidence: float = 0.95) -> float:
     if trials <= 0:
         return 1.0
     return 1.0 - (1.0 - confidence) ** (1.0 / trials)
-
-
-def adjacent_pairs(model: Model, with_geometry: Iterable[str]) -> set[frozenset[str]]:
-    """Pairs of links with geometry joined by a joint, looking through links without geometry.
-
-    Walks the joint graph (undirected) from each link with geometry, passing through links without
-    geometry, stopping at the first link with geometry on each path: panda_link7 - (link8) -
-    panda_hand is adjacent.
-    """
-    solid = set(with_geometry)
-    neighbours: dict[str, set[str]] = {}
-    for joint in model.joints:
-        if joint.parent and joint.child:
-            neighbours.setdefault(joint.parent, set()).add(joint.child)
-            neighbours.setdefault(joint.child, set()).add(joint.parent)
-    pairs: set[frozenset[str]] = set()
-    for start in solid:
-        seen, frontier = {start}, [start]
-        while frontier:
-            link = frontier.pop()
-            for other in neighbours.get(link, ()):
-                if other in seen:
-                    continue
-                seen.add(other)
-                if other in solid:
-                    pairs.add(frozenset((start, other)))
-                else:
-                    frontier.append(other)
-    return pairs
-
-
-def direct_parent_child(model: Model) -> set[frozenset[str]]:
-    """Pairs a joint joins directly: the only ones URDF_USE_SELF_COLLISION leaves out."""
-    return {frozenset((j.parent, j.child)) for j in model.joints if j.parent and j.child}
 
 
 @dataclass

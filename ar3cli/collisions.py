@@ -18,9 +18,11 @@ Two measured facts shape this module:
   what makes the merged counts identical for any number of jobs.
 - ``getContactPoints`` also reports points at small positive distance (up to ~4 mm on the panda) and
   faces that rest exactly on each other (distance ~1e-17). A pair counts as *colliding* only when it
-  penetrates deeper than :data:`CONTACT_TOLERANCE` (1 um).
+  penetrates deeper than :data:`~ar3cli.sim.PENETRATION_TOLERANCE` (1 um), the threshold lint-urdf's
+  P002 and render use too.
 
-Configurations are generated up front in the parent from ``numpy.random.default_rng(seed)``, split
+Configurations are generated up front in the parent by :mod:`ar3cli.sampling` (only the driving
+joints are drawn from ``numpy.random.default_rng(seed)``; ``<mimic>`` joints follow), split
 into chunks, counted by worker processes (one PyBullet client each) and summed: the counts are exact
 and independent of the number of jobs.
 """
@@ -36,11 +38,17 @@ from pathlib import Path
 
 import numpy as np
 
+from ar3cli.adjacency import collision_links
 from ar3cli.errors import UserError
 from ar3cli.model import Model, load_model
+from ar3cli.sampling import JointSpace, joint_space, limit_configurations, sample_configurations
+from ar3cli.sim import PENETRATION_TOLERANCE
 
-CONTACT_TOLERANCE = 1e-6
-"""m: a pair collides when its deepest contact point penetrates more than this."""
+__all__ = ["Checker", "JointSpace", "ModelSource", "collision_links", "count_collisions", "limit_configurations",
+           "sample_configurations"]
+
+CONTACT_TOLERANCE = PENETRATION_TOLERANCE
+"""m: a pair collides when its deepest contact point penetrates more than this (the shared constant)."""
 CONTACT_BREAKING_THRESHOLD = 1e-5
 """m: Bullet drops manifold points that drifted more than this; small, so teleports leave no stale points."""
 
@@ -55,60 +63,6 @@ class ModelSource:
 
     def load(self) -> Model:
         return load_model(self.path, self.package_paths or None, self.xacro_args or None)
-
-
-@dataclass(frozen=True)
-class JointSpace:
-    """The movable joints in pybullet order, with the range a uniform sampler draws from."""
-
-    names: tuple[str, ...]
-    lower: np.ndarray
-    upper: np.ndarray
-    continuous: tuple[bool, ...]
-    home: np.ndarray
-
-    @property
-    def dof(self) -> int:
-        return len(self.names)
-
-
-def collision_links(model: Model) -> list[str]:
-    """Links with at least one ``<collision>`` whose geometry parses, in file order."""
-    return [link.name for link in model.links
-            if any(shape.geometry.kind is not None for shape in link.collisions)]
-
-
-def sample_configurations(space: JointSpace, samples: int, seed: int) -> np.ndarray:
-    """``samples`` x DOF uniform configurations; continuous joints in [-pi, pi). Same seed, same matrix."""
-    rng = np.random.default_rng(seed)
-    return rng.uniform(space.lower, space.upper, size=(samples, space.dof))
-
-
-def limit_configurations(space: JointSpace) -> list[tuple[str, np.ndarray]]:
-    """The home pose, then each limited joint at its lower and upper limit (others at home), then all
-    limited joints at lower and all at upper; duplicates of an earlier configuration are dropped.
-
-    Continuous joints stay at home: -pi and pi are the same pose, not a limit.
-    """
-    candidates: list[tuple[str, np.ndarray]] = [("home", space.home.copy())]
-    limited = [index for index in range(space.dof) if not space.continuous[index]]
-    for index in limited:
-        for label, bound in (("lower", space.lower), ("upper", space.upper)):
-            q = space.home.copy()
-            q[index] = bound[index]
-            candidates.append((f"{space.names[index]} at {label}", q))
-    for label, bound in (("lower", space.lower), ("upper", space.upper)):
-        q = space.home.copy()
-        q[limited] = bound[limited]
-        candidates.append((f"all at {label}", q))
-    seen: set[tuple[float, ...]] = set()
-    unique = []
-    for label, q in candidates:
-        key = tuple(q.tolist())
-        if key not in seen:
-            seen.add(key)
-            unique.append((label, q))
-    return unique
 
 
 class Checker:
@@ -152,15 +106,8 @@ class Checker:
         self.session.close()
 
     def joint_space(self) -> JointSpace:
-        joints = self.body.movable_joints
-        ranges = [joint.sample_range() for joint in joints]
-        return JointSpace(
-            names=tuple(joint.name for joint in joints),
-            lower=np.array([r[0] for r in ranges], dtype=float),
-            upper=np.array([r[1] for r in ranges], dtype=float),
-            continuous=tuple(joint.continuous for joint in joints),
-            home=np.array([joint.home() for joint in joints], dtype=float),
-        )
+        """The body's joint space (:mod:`ar3cli.sampling`): mimic joints follow their source."""
+        return joint_space(self.body)
 
     def colliding(self, q: Sequence[float]) -> list[int]:
         """Pair ids in collision at one configuration, sorted."""

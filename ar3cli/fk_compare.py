@@ -63,49 +63,45 @@ class Comparison:
 
 
 def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
-    """Uniform samples within each driving joint's range (continuous: [-pi, pi)); mimic joints follow.
+    """Uniform samples of the driving joints (:mod:`ar3cli.sampling`); mimic joints follow.
 
     Ranges come from :meth:`ar3cli.sim.JointRecord.sample_range`, i.e. the URDF's limits.
     """
-    rng = np.random.default_rng(seed)
-    driving = [joint for joint in body.movable_joints if joint.urdf is None or joint.urdf.mimic is None
-               or model.joint(joint.urdf.mimic.joint) is None]
-    ranges = np.array([joint.sample_range() for joint in driving]).reshape(-1, 2)
-    values = rng.uniform(ranges[:, 0], ranges[:, 1], size=(count, len(driving)))
-    names = [joint.name for joint in driving]
+    from ar3cli import sampling
+
+    space = sampling.joint_space(body)
+    values = sampling.sample_driving(space, count, seed)
+    names = list(space.driving_names)
     all_values = kinematics.driven_values(model, {n: values[:, i] for i, n in enumerate(names)}, count)
     return Samples(seed=seed, names=names, values=values, all_values=all_values)
 
 
-def pybullet_frames(body, samples: Samples, com: bool = False) -> dict[str, np.ndarray]:
-    """(N, 4, 4) world frames per link from pybullet, every joint (mimic ones too) set explicitly.
-
-    ``com=True`` reads the centre-of-mass frames instead (``getLinkState(...)[0:2]`` and the raw base
-    pose): the tutorial mistake, kept so tests can show what it costs.
-    """
-    p, client = body.session.p, body.session.client
+def body_configurations(body, samples: Samples) -> np.ndarray:
+    """(N, movable joints) values in :attr:`~ar3cli.sim.Body.movable_joints` order, mimic joints included."""
     names = [joint.name for joint in body.movable_joints]
-    indices = [joint.index for joint in body.joints]
-    links = body.link_names
-    positions = np.zeros((samples.count, len(links), 3))
-    quaternions = np.zeros((samples.count, len(links), 4))
-    columns = np.stack([samples.all_values[name] for name in names], axis=1) if names else np.zeros((samples.count, 0))
-    for n in range(samples.count):
-        body.set_positions(columns[n])
-        if com:
-            base = p.getBasePositionAndOrientation(body.id, physicsClientId=client)
-            states = p.getLinkStates(body.id, indices, computeForwardKinematics=True,
-                                     physicsClientId=client) if indices else []
-            poses = [base, *((state[0], state[1]) for state in states)]
-        else:
-            frames = body.link_frames()
-            poses = [frames[link] for link in links]
-        for i, (position, orientation) in enumerate(poses):
-            positions[n, i] = position
-            quaternions[n, i] = orientation
+    if not names:
+        return np.zeros((samples.count, 0))
+    return np.stack([samples.all_values[name] for name in names], axis=1)
+
+
+def pybullet_frames(body, samples: Samples) -> dict[str, np.ndarray]:
+    """(N, 4, 4) world link frames per link from pybullet, every joint (mimic ones too) set explicitly."""
+    poses = []
+    for q in body_configurations(body, samples):
+        body.set_positions(q)
+        frames = body.link_frames()
+        poses.append([frames[link] for link in body.link_names])
+    return frames_from_poses(body.link_names, poses)
+
+
+def frames_from_poses(links: list[str], poses) -> dict[str, np.ndarray]:
+    """{link: (N, 4, 4)} from ``poses[n][i]`` = (position, quaternion xyzw) of ``links[i]`` in sample n."""
+    count = len(poses)
+    positions = np.array([[pose[0] for pose in row] for row in poses], dtype=float).reshape(count, len(links), 3)
+    quaternions = np.array([[pose[1] for pose in row] for row in poses], dtype=float).reshape(count, len(links), 4)
     result = {}
     for i, link in enumerate(links):
-        frames = np.tile(np.eye(4), (samples.count, 1, 1))
+        frames = np.tile(np.eye(4), (count, 1, 1))
         frames[:, :3, :3] = kinematics.quaternion_matrices(quaternions[:, i])
         frames[:, :3, 3] = positions[:, i]
         result[link] = frames

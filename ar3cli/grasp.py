@@ -177,7 +177,7 @@ class IKSolver:
     def close(self) -> None:
         """Remove the IK copy from the world."""
         if self.body is not None:
-            self.p.removeBody(self.body.id, physicsClientId=self.client)
+            self.body.remove()
             self.body = None
 
     def solve(self, position: Sequence[float], orientation: Sequence[float],

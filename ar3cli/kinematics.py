@@ -24,10 +24,10 @@ import numpy as np
 
 from ar3cli.errors import UserError
 from ar3cli.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
-from ar3cli.model import Joint, Model
+from ar3cli.model import ACTUATED_JOINT_TYPES, ROTATING_JOINT_TYPES, Joint, Model
 
-REVOLUTE_TYPES = ("revolute", "continuous")
-SUPPORTED_TYPES = ("revolute", "continuous", "prismatic", "fixed")
+SUPPORTED_TYPES = (*ACTUATED_JOINT_TYPES, "fixed")
+"""Joint types the URDF forward kinematics here can place (not planar, floating or spherical)."""
 
 
 def matrix_rpy(rotation: np.ndarray) -> tuple[float, float, float]:
@@ -87,7 +87,7 @@ def unit_axis(joint: Joint) -> np.ndarray:
 
 def joint_motion(joint: Joint, values: np.ndarray) -> np.ndarray:
     """(N, 4, 4) motion of ``joint`` at ``values`` in its own frame (after its origin)."""
-    if joint.type in REVOLUTE_TYPES:
+    if joint.type in ROTATING_JOINT_TYPES:
         return axis_rotations(unit_axis(joint), values)
     motion = np.tile(np.eye(4), (len(values), 1, 1))
     if joint.type == "prismatic":
@@ -116,7 +116,7 @@ def driven_values(model: Model, positions: Mapping[str, np.ndarray], count: int)
         return result
 
     for joint in model.joints:
-        if joint.type in ("revolute", "continuous", "prismatic"):
+        if joint.type in ACTUATED_JOINT_TYPES:
             value_of(joint)
     return values
 

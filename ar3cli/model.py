@@ -22,8 +22,14 @@ from ar3cli.packages import PackageResolver, Resolution
 from ar3cli.xmlsource import Quirk
 
 Vec3 = tuple[float, float, float]
-MOVING_JOINT_TYPES = ("revolute", "continuous", "prismatic", "planar", "floating")
-"""Joint types whose child link moves relative to its parent."""
+ROTATING_JOINT_TYPES = ("revolute", "continuous")
+"""1-DOF joints that turn about their axis."""
+ACTUATED_JOINT_TYPES = (*ROTATING_JOINT_TYPES, "prismatic")
+"""1-DOF joints: the ones PyBullet reports with one position and drives with one motor."""
+MOVING_JOINT_TYPES = (*ACTUATED_JOINT_TYPES, "planar", "floating", "spherical")
+"""Joint types whose child link moves relative to its parent (``spherical`` is PyBullet's ball joint)."""
+URDF_JOINT_TYPES = (*ACTUATED_JOINT_TYPES, "fixed", "floating", "planar")
+"""The joint types of the URDF spec."""
 
 
 def parse_floats(text: str | None, count: int | None = None) -> tuple[float, ...] | None:

@@ -2,9 +2,10 @@
 
 The camera frames the robot's bounding box at the chosen configuration. Optionally the collision
 geometry is drawn (in blue, in place of the visual geometry: TinyRenderer has no transparency, so a
-true overlay z-fights with the visual surfaces it coincides with), and links in contact with a link
-they are not joined to are drawn red: the picture shows what ``lint-urdf --sim`` reports as
-"in collision at the home pose".
+true overlay z-fights with the visual surfaces it coincides with), and links that interpenetrate a
+link they are not adjacent to are drawn red, by :func:`ar3cli.adjacency.nonadjacent_collisions`:
+at the home pose the picture shows exactly what ``lint-urdf --sim`` (P002) and sample-collisions
+("default") report.
 """
 
 from __future__ import annotations
@@ -82,6 +83,7 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
     """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``."""
     from PIL import Image
 
+    from ar3cli.adjacency import nonadjacent_collisions
     from ar3cli.sim import SELF_COLLISION_ALL_PAIRS, Session
 
     if not 16 <= width <= 4096 or not 16 <= height <= 4096:
@@ -94,10 +96,9 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
         if unknown:
             raise UserError(f"--config names unknown joints: {', '.join(unknown)} "
                             f"(movable joints: {', '.join(joints) or 'none'})")
-        values = {name: joint.home() for name, joint in joints.items()}
-        values.update(configuration or {})
+        values = configuration_with_mimics(body, configuration or {})
         body.set_positions(values)
-        contacts = _contacts_between_unjoined_links(model, body.contacts()) if show_contacts else []
+        contacts = nonadjacent_collisions(body, model) if show_contacts else []
         for link_name in {name for a, b, _ in contacts for name in (a, b)}:
             session.p.changeVisualShape(body.id, body.link_index[link_name], rgbaColor=CONTACT_RGBA,
                                         physicsClientId=session.client)
@@ -109,9 +110,18 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
     return RenderResult(output, width, height, values, contacts)
 
 
-def _contacts_between_unjoined_links(model: Model, contacts: list[tuple[str, str, float]]):
-    joined = {frozenset((joint.parent, joint.child)) for joint in model.joints}
-    return [(a, b, depth) for a, b, depth in contacts if frozenset((a, b)) not in joined]
+def configuration_with_mimics(body, configuration: Mapping[str, float]) -> dict[str, float]:
+    """Every movable joint's value: the given ones, the other driving joints at home, and mimic
+    joints following their source unless given explicitly (a robot cannot be in any other state)."""
+    import numpy as np
+
+    from ar3cli.sampling import joint_space
+
+    space = joint_space(body)
+    driving = [configuration.get(name, space.home[index]) for index, name in zip(space.driving, space.driving_names)]
+    values = space.as_dict(space.fill(np.array([driving], dtype=float))[0])
+    values.update(configuration)
+    return values
 
 
 def _snapshot(session, body, width: int, height: int, yaw_deg: float, pitch_deg: float):

@@ -89,6 +89,19 @@ def test_independent_fk_matches_yourdfpy_to_machine_precision(pybullet_data_dir:
     assert worst < 1e-12
 
 
+def _com_frames(session, body, samples) -> dict[str, np.ndarray]:
+    """The tutorial mistake: the raw base pose and getLinkState(...)[0:2], i.e. centre-of-mass frames."""
+    p, client = session.p, session.client
+    indices = [joint.index for joint in body.joints]
+    poses = []
+    for q in fk_compare.body_configurations(body, samples):
+        body.set_positions(q)
+        base = p.getBasePositionAndOrientation(body.id, physicsClientId=client)
+        states = p.getLinkStates(body.id, indices, computeForwardKinematics=True, physicsClientId=client)
+        poses.append([base, *((state[0], state[1]) for state in states)])
+    return fk_compare.frames_from_poses(body.link_names, poses)
+
+
 def test_com_instead_of_link_frame_fails_by_the_com_offset(write_urdf) -> None:
     """The tutorial trap: getLinkState[0] is the COM. [4] passes; [0] is off by exactly the inertial offset."""
     from ar3cli.sim import Session
@@ -100,7 +113,7 @@ def test_com_instead_of_link_frame_fails_by_the_com_offset(write_urdf) -> None:
         samples = fk_compare.sample_configurations(model, body, 30, 0)
         reference = kinematics.urdf_link_frames(model, samples.all_values, samples.count)
         right = fk_compare.compare_links(reference, fk_compare.pybullet_frames(body, samples))
-        wrong = fk_compare.compare_links(reference, fk_compare.pybullet_frames(body, samples, com=True))
+        wrong = fk_compare.compare_links(reference, _com_frames(session, body, samples))
     by_link = {e.link: e for e in right}
     assert by_link["arm"].max_position < PYBULLET_FLOOR_M
     offset = {e.link: e for e in wrong}["arm"]

@@ -79,6 +79,9 @@ EXTRA_FAILING = [
     ("J005", arm(joint_extra='<limit lower="0" upper="180" effort="10" velocity="1"/>'), {}),
     ("J008", arm(joint_extra='<limit lower="-1" upper="1" effort="-5" velocity="1"/>'), {}),
     ("I001", arm(joint_type="prismatic", link_extra=""), {}),
+    ("I001", arm(joint_type="spherical", joint_extra="", link_extra=""), {}),  # PyBullet moves ball joints
+    ("I003", arm(joint_type="spherical", joint_extra="",
+                 link_extra='<inertial><mass value="0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'), {}),
     ("I003", arm(link_extra='<inertial><mass value="-2"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'), {}),
     ("I004", arm(link_extra='<inertial><mass value="1"/><inertia ixx="0.01" ixy="0.02" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'), {}),
     ("I006", arm(link_extra='<inertial><mass value="1"/></inertial>'), {}),

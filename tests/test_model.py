@@ -252,3 +252,15 @@ def test_xacro_unknown_package(tmp_path):
                     '</visual></link></robot>')
     with pytest.raises(UserError, match="nowhere_pkg.*--package-path"):
         load_model(path)
+
+
+def test_joint_type_sets_are_defined_once(write_urdf):
+    """ACTUATED (pybullet's 1-DOF joints) is a subset of MOVING; a spherical joint moves its child."""
+    from ar3cli import model as model_module
+
+    assert model_module.ACTUATED_JOINT_TYPES == ("revolute", "continuous", "prismatic")
+    assert set(model_module.ACTUATED_JOINT_TYPES) < set(model_module.MOVING_JOINT_TYPES)
+    assert {"planar", "floating", "spherical"} <= set(model_module.MOVING_JOINT_TYPES)
+    text = ARM.replace('name="spin" type="continuous"', 'name="spin" type="spherical"')
+    model = load_model(write_urdf(text))
+    assert model.joint("spin").moves and model.joint("spin") in model.movable_joints()

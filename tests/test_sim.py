@@ -161,3 +161,39 @@ def test_every_pybullet_data_model_loads_or_explains(pybullet_data_dir):
     assert "meshes/coarse/link_0.stl" in failures["kuka_iiwa/model_for_sdf.urdf"]
     assert "torus.vtk" in failures["torus_deform.urdf"]
     assert "concave_box.cdf" in failures["toys/concave_box.urdf"]
+
+
+def test_body_dynamics_joint_states_and_remove(session, write_urdf):
+    body = session.load(load_model(write_urdf(OFFSET_COM)))
+    base, arm = body.dynamics("base"), body.dynamics("arm")
+    assert base.mass == 0 and arm.mass == 1  # a fixed base has mass 0 in PyBullet
+    assert arm.inertia_diagonal == pytest.approx((0.02, 0.02, 0.001))  # from the file (default load flags)
+    assert base.inertial_position == pytest.approx((0.1, 0, 0)) and arm.inertial_position == pytest.approx((0, 0, 0.25))
+    body.set_positions([0.7])
+    ((position, velocity),) = body.joint_states()
+    assert position == pytest.approx(0.7) and velocity == 0
+    p = session.p
+    assert p.getNumBodies(physicsClientId=session.client) == 1
+    body.remove()
+    body.remove()  # twice is harmless
+    assert p.getNumBodies(physicsClientId=session.client) == 0
+
+
+TOUCHING = """<?xml version="1.0"?>
+<robot name="stack">
+  <link name="a"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="b"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <link name="c"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="ab" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 0.1"/></joint>
+  <joint name="ac" type="fixed"><parent link="a"/><child link="c"/><origin xyz="0 0.095 0"/></joint>
+</robot>
+"""
+
+
+def test_contacts_min_depth_skips_resting_and_separated_points(session, write_urdf):
+    """a-b rest face to face (depth ~1e-17), a-c overlap by 5 mm; min_depth keeps only the overlap."""
+    body = session.load(load_model(write_urdf(TOUCHING)), self_collision="all-pairs")
+    everything = {(a, b): depth for a, b, depth in body.contacts()}
+    assert abs(everything[("a", "b")]) < 1e-12 and everything[("a", "c")] == pytest.approx(-0.005, abs=1e-9)
+    deep = body.contacts(min_depth=1e-6)
+    assert [(a, b) for a, b, _ in deep] == [("a", "c")]

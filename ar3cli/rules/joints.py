@@ -5,10 +5,11 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 
+from ar3cli.model import ACTUATED_JOINT_TYPES as ACTUATED_TYPES
 from ar3cli.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 
 LIMITED_TYPES = ("revolute", "prismatic")
-ACTUATED_TYPES = ("revolute", "continuous", "prismatic")
+"""The types the URDF spec requires a <limit> with lower/upper on."""
 DEGREE_THRESHOLD = 2 * math.pi + 0.01
 """A revolute limit beyond one full turn is almost always a value in degrees."""
 

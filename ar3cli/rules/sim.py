@@ -1,7 +1,8 @@
 """Simulation rules (P, only with ``--sim``): load the model in PyBullet and see what it really does.
 
-Each rule loads the model in the file's shared :class:`~ar3cli.sim.Session` (``ctx.session``),
-checks one thing and removes the body again, so the rules are independent of each other.
+Each rule loads the model in the file's shared :class:`~ar3cli.sim.Session` (``ctx.session``,
+gravity -9.81 m/s^2), checks one thing and removes the body again, so the rules are independent of
+each other.
 """
 
 from __future__ import annotations
@@ -13,8 +14,6 @@ from contextlib import contextmanager
 from ar3cli.errors import UserError
 from ar3cli.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 
-PENETRATION_TOLERANCE = 5e-4
-"""Contacts shallower than this (m) are touching surfaces, not a collision worth reporting."""
 INERTIA_TOLERANCE = 0.10
 """Relative difference between the file and PyBullet's value above which P003 reports a link."""
 SETTLE_STEPS = 240
@@ -34,11 +33,13 @@ def _loaded(ctx, **load_options):
     try:
         yield body
     finally:
-        session.p.removeBody(body.id, physicsClientId=session.client)
+        body.remove()
 
 
 def _home(body) -> dict[str, float]:
-    return {joint.name: joint.home() for joint in body.movable_joints}
+    from ar3cli.sampling import home_positions
+
+    return home_positions(body)
 
 
 @rule("P001", "sim-load-failed", "error", "PyBullet cannot load the model",
@@ -53,45 +54,51 @@ def sim_load_failed(ctx) -> Iterator[Hit]:
     except UserError as exc:
         yield Hit(exc.message.removeprefix(f"{ctx.model.path}: "), ctx.model.root)
         return
-    ctx.session.p.removeBody(body.id, physicsClientId=ctx.session.client)
+    body.remove()
 
 
 @rule("P002", "sim-self-collision-home", "warning", "Links collide at the home pose",
-      why="""Two links that are not parent and child but interpenetrate at the home pose (all joints at
-      0, or mid-range where 0 is outside the limits) mean overlapping collision meshes or a wrong
-      joint origin. With self-collision on, PyBullet pushes them apart the moment the simulation
-      starts; planners see the start state as invalid.""",
+      why="""Two links that are not adjacent but interpenetrate (deeper than 1 µm) at the home pose
+      (all joints at 0, or mid-range where 0 is outside the limits; mimic joints following) mean
+      overlapping collision meshes or a wrong joint origin. With self-collision on, PyBullet pushes
+      them apart the moment the simulation starts; planners see the start state as invalid.
+      Adjacent is MoveIt's rule, as in sample-collisions: joined by a joint, looking through links
+      without collision geometry (their overlap is by construction).""",
       fix="Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
           "(SRDF / setCollisionFilterPair).",
       bad=robot(f"""
           <link name="base">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <link name="mid">{LINK_INERTIAL}</link>
+          <link name="mid">{LINK_INERTIAL}<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link>
           <link name="tip">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.05"/>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.3"/>
             <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 0.05"/>
+          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 -0.25"/>
             <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
       good=robot(f"""
           <link name="base">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <link name="mid">{LINK_INERTIAL}</link>
+          <link name="mid">{LINK_INERTIAL}<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link>
           <link name="tip">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.2"/>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.3"/>
             <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 0.2"/>
+          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 0.25"/>
             <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
-    adjacent = {frozenset((j.parent, j.child)) for j in ctx.model.joints}
+    from ar3cli.adjacency import nonadjacent_collisions
+
     with _loaded(ctx, self_collision="all-pairs") as body:
         if body is None:
             return
         body.set_positions(_home(body))
-        for a, b, depth in body.contacts():
-            if frozenset((a, b)) in adjacent or depth > -PENETRATION_TOLERANCE:
-                continue
+        for a, b, depth in nonadjacent_collisions(body):
             link = ctx.model.link(b) or ctx.model.link(a)
-            yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.1f} mm at the home pose",
+            yield Hit(f"links '{a}' and '{b}' interpenetrate by {_depth_text(-depth)} at the home pose",
                       link.element if link else None)
+
+
+def _depth_text(depth: float) -> str:
+    """0.1 mm and deeper in mm, shallower in µm (a 4 µm overlap is not '0.0 mm')."""
+    return f"{depth * 1000:.1f} mm" if depth >= 1e-4 else f"{depth * 1e6:.1f} µm"
 
 
 @rule("P003", "sim-inertia-differs", "info", "PyBullet uses a different mass or inertia than the file",
@@ -110,19 +117,17 @@ def sim_inertia_differs(ctx) -> Iterator[Hit]:
     """
     from ar3cli.rules.inertia import _finite, _moments
 
-    session = ctx.session
-    p = session.p
     changed: list[tuple[float, str, object]] = []  # (relative difference, description, element)
-    with _loaded(ctx, fixed_base=False, flags=p.URDF_MAINTAIN_LINK_ORDER) as body:
+    with _loaded(ctx, fixed_base=False, flags=ctx.session.p.URDF_MAINTAIN_LINK_ORDER) as body:
         if body is None:
             return
         for link in ctx.model.links:
             inertial = link.inertial
-            index = body.link_index.get(link.name)
-            if index is None or inertial is None or not _finite(inertial.tensor) or not (inertial.mass or 0) > 0:
+            if link.name not in body.link_index or inertial is None or not _finite(inertial.tensor) \
+                    or not (inertial.mass or 0) > 0:
                 continue
-            info = p.getDynamicsInfo(body.id, index, physicsClientId=session.client)
-            used_mass, used = float(info[0]), sorted(float(v) for v in info[2])
+            dynamics = body.dynamics(link.name)
+            used_mass, used = dynamics.mass, sorted(dynamics.inertia_diagonal)
             file_moments = sorted(float(m) for m in _moments(inertial.tensor))
             parts = []
             if _differs(used_mass, inertial.mass):
@@ -159,19 +164,13 @@ def _differs(used: float, declared: float) -> bool:
                          '</inertial>').replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'),
       good=arm(), needs_sim=True)
 def sim_unstable(ctx) -> Iterator[Hit]:
-    session = ctx.session
-    p = session.p
     with _loaded(ctx) as body:
         if body is None or not body.movable_joints:
             return
-        p.setGravity(0, 0, -9.81, physicsClientId=session.client)
         body.set_positions(_home(body))
         body.release_motors()
-        session.step(SETTLE_STEPS)
-        indices = [joint.index for joint in body.movable_joints]
-        states = p.getJointStates(body.id, indices, physicsClientId=session.client)
-        for joint, state in zip(body.movable_joints, states):
-            position, velocity = float(state[0]), float(state[1])
+        ctx.session.step(SETTLE_STEPS)  # the lint session has gravity (lint.Context.session)
+        for joint, (position, velocity) in zip(body.movable_joints, body.joint_states()):
             if not (math.isfinite(position) and math.isfinite(velocity)):
                 yield Hit(f"joint '{joint.name}' state is NaN/inf after {SETTLE_STEPS} steps under gravity",
                           joint.urdf.element if joint.urdf else None)

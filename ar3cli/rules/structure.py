@@ -5,9 +5,10 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterator
 
+from ar3cli.model import URDF_JOINT_TYPES
 from ar3cli.rules.base import Hit, arm, robot, rule
 
-JOINT_TYPES = ("revolute", "continuous", "prismatic", "fixed", "floating", "planar")
+JOINT_TYPES = URDF_JOINT_TYPES
 PYBULLET_JOINT_TYPES = ("spherical",)
 """Joint types PyBullet accepts beyond the URDF spec (S010)."""
 

@@ -1,0 +1,76 @@
+"""Which links are adjacent, and which collide at the home pose: one answer for every command.
+
+lint-urdf --sim (P002), render and sample-collisions all ask "are two links that are not adjacent
+interpenetrating?". They use the same two definitions, from here:
+
+- **Adjacent** is MoveIt Setup Assistant's rule (``compute_default_collisions.cpp``): two links
+  with collision geometry joined by a joint, links *without* collision geometry being transparent
+  (removed, their neighbours joined). pybullet_data's panda_link7 and panda_hand are adjacent
+  through the geometry-less panda_link8: a URDF cannot put geometry between them, so their
+  overlap is by construction, not a modelling error.
+- **Colliding** is penetrating deeper than :data:`ar3cli.sim.PENETRATION_TOLERANCE` (1 um):
+  resting faces (depth ~1e-16 m) and points at a positive distance do not count.
+
+:func:`direct_parent_child` is something else: the pairs PyBullet's ``URDF_USE_SELF_COLLISION``
+flag skips, used where ar3cli explains what that flag does.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+from ar3cli.model import Model
+
+
+def collision_links(model: Model) -> list[str]:
+    """Links with at least one ``<collision>`` whose geometry parses, in file order."""
+    return [link.name for link in model.links
+            if any(shape.geometry.kind is not None for shape in link.collisions)]
+
+
+def adjacent_pairs(model: Model, with_geometry: Iterable[str] | None = None) -> set[frozenset[str]]:
+    """Pairs of links with geometry joined by a joint, looking through links without geometry.
+
+    Walks the joint graph (undirected) from each link with geometry (default:
+    :func:`collision_links`), passing through links without geometry, stopping at the first link
+    with geometry on each path: panda_link7 - (link8) - panda_hand is adjacent.
+    """
+    solid = set(collision_links(model) if with_geometry is None else with_geometry)
+    neighbours: dict[str, set[str]] = {}
+    for joint in model.joints:
+        if joint.parent and joint.child:
+            neighbours.setdefault(joint.parent, set()).add(joint.child)
+            neighbours.setdefault(joint.child, set()).add(joint.parent)
+    pairs: set[frozenset[str]] = set()
+    for start in solid:
+        seen, frontier = {start}, [start]
+        while frontier:
+            link = frontier.pop()
+            for other in neighbours.get(link, ()):
+                if other in seen:
+                    continue
+                seen.add(other)
+                if other in solid:
+                    pairs.add(frozenset((start, other)))
+                else:
+                    frontier.append(other)
+    return pairs
+
+
+def direct_parent_child(model: Model) -> set[frozenset[str]]:
+    """Pairs a joint joins directly: the only ones URDF_USE_SELF_COLLISION leaves out."""
+    return {frozenset((j.parent, j.child)) for j in model.joints if j.parent and j.child}
+
+
+def nonadjacent_collisions(body: Any, model: Model | None = None) -> list[tuple[str, str, float]]:
+    """Non-adjacent pairs penetrating deeper than the tolerance at the body's *current* pose.
+
+    ``body`` must be loaded with ``self_collision="all-pairs"``; ``model`` (default
+    ``body.model``) gives the adjacency. Returns (link_a, link_b, depth in m, negative).
+    """
+    from ar3cli.sim import PENETRATION_TOLERANCE
+
+    adjacent = adjacent_pairs(model or body.model)
+    return [(a, b, depth) for a, b, depth in body.contacts(min_depth=PENETRATION_TOLERANCE)
+            if frozenset((a, b)) not in adjacent]
