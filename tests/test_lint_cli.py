@@ -213,11 +213,16 @@ def test_static_lint_does_not_import_numpy_pybullet_or_trimesh(tmp_path, pybulle
             f"try:\n    main(['lint-urdf', '--format', 'json', *{files!r}])\nexcept SystemExit:\n    pass\n"
             "from ar3cli.meshinfo import _mesh_bounds\nprint(_mesh_bounds.cache_info().currsize)\n"
             "print(sorted(m for m in ('numpy', 'pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO,
-                         env={"PYTHONPATH": str(REPO), "NO_COLOR": "1", "PATH": "/usr/bin:/bin"})
-    doc, meshes_read, modules = out.stdout.strip().rsplit("\n", 2)
-    assert modules == "[]", out.stderr
-    assert json.loads(doc)["summary"]["files"] == 2 and meshes_read == "18"  # all 18 panda meshes were read
+    env = {"PYTHONPATH": str(REPO), "NO_COLOR": "1", "PATH": "/usr/bin:/bin", "AR3CLI_CACHE_DIR": str(tmp_path / "c")}
+    runs = []
+    for _ in range(2):
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=REPO, env=env)
+        doc, meshes_read, modules = out.stdout.strip().rsplit("\n", 2)
+        assert modules == "[]", out.stderr
+        runs.append((json.loads(doc), meshes_read))
+    (first, first_read), (second, second_read) = runs
+    assert first["summary"]["files"] == 2 and first_read == "18"  # all 18 panda meshes were read
+    assert second == first and second_read == "0"  # the next process takes their bounds from the disk cache
 
 
 def test_sim_rules_run_only_with_sim(cli, write_urdf):
