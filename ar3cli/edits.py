@@ -124,6 +124,17 @@ class Document:
         if attribute is not None:
             self.splice(attribute.start, attribute.end, b"")
 
+    def remove_element(self, span: Span) -> None:
+        """Remove an element; when it stands alone on its line, the whole line goes with it."""
+        line_start = self.data.rfind(b"\n", 0, span.start) + 1
+        line_end = self.data.find(b"\n", span.end)
+        line_end = len(self.data) if line_end < 0 else line_end + 1
+        alone = not self.data[line_start:span.start].strip() and not self.data[span.end:line_end].strip()
+        if alone:
+            self.splice(line_start, line_end, b"")
+        else:
+            self.splice(span.start, span.end, b"")
+
     def insert_child(self, parent: Span, lines: list[str], after: Span | None = None,
                      before: Span | None = None) -> None:
         """Insert a new child element given as text lines (relative indentation in units of 2 spaces).

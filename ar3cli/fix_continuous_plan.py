@@ -23,6 +23,8 @@ from ar3cli.errors import UserError
 from ar3cli.fixing import Change, FixPlan, Skipped, number
 
 FULL_TURN = 2.0 * math.pi
+FULL_TURN_TOLERANCE = 1e-6
+"""rad: files write pi with 8-9 digits (-3.14159265 .. 3.14159265 falls 7e-9 short of a full turn)."""
 
 
 @dataclass(frozen=True)
@@ -115,48 +117,48 @@ def _record(plan: FixPlan, joint, **values) -> None:
 
 
 def _remove_fake_limits(document: Document, plan: FixPlan, joint, options: ContinuousOptions) -> None:
+    """Continuous joint: drop lower/upper; keep effort/velocity, adding them from the options.
+
+    urdfdom refuses a ``<limit>`` without effort and velocity, so the fix never leaves one behind:
+    when neither is known the whole element goes (a continuous joint needs no ``<limit>``); when
+    only one is known, the joint is left alone and reported (pass the other option).
+    """
     limit = joint.element.find("limit")
-    if limit is None or (limit.get("lower") is None and limit.get("upper") is None):
+    line = (limit.sourceline if limit is not None else None) or joint.line
+    present = {key: limit.get(key) if limit is not None else None for key in ("effort", "velocity")}
+    added = {key: number(value) for key, value in (("effort", options.effort), ("velocity", options.velocity))
+             if value is not None and present[key] is None}
+    has_range = limit is not None and any(limit.get(key) is not None for key in ("lower", "upper"))
+    if not has_range and not added:
         return
-    span = document.span(limit)
-    line = limit.sourceline or joint.line
+    final = {key: present[key] if present[key] is not None else added.get(key) for key in present}
+    missing = [key for key, value in final.items() if value is None]
+    if len(missing) == 1:
+        have = next(key for key in final if final[key] is not None)
+        plan.skipped.append(Skipped(_element(joint), line, f"its <limit> would keep {have} but no {missing[0]}; "
+                                                           f"urdfdom requires both: pass --{missing[0]}"))
+        return
+    reason = "ignored by the URDF spec; pybullet only clamps position targets to it"
+    if missing:  # neither effort nor velocity: an empty <limit/> is invalid, a continuous joint needs none
+        document.remove_element(document.span(limit))
+        reason += "; the <limit> had no effort/velocity either, so it is removed"
+    elif limit is None:
+        q = document.quote.decode()
+        document.insert_child(document.span(joint.element),
+                              [f"<limit effort={q}{final['effort']}{q} velocity={q}{final['velocity']}{q}/>"])
+    else:
+        span = document.span(limit)
+        for key in ("lower", "upper"):
+            if limit.get(key) is not None:
+                document.remove_attribute(span, key)
+        for key, value in added.items():
+            document.set_attribute(span, key, value)
     for key in ("lower", "upper"):
-        if limit.get(key) is not None:
-            document.remove_attribute(span, key)
-            plan.changes.append(Change(_element(joint), line, f"limit {key}", limit.get(key), None,
-                                       "ignored by the URDF spec; pybullet only clamps position targets to it"))
-    _ensure_effort_velocity(document, plan, joint, limit, {}, options, required=False)
+        if limit is not None and limit.get(key) is not None:
+            plan.changes.append(Change(_element(joint), line, f"limit {key}", limit.get(key), None, reason))
+    for key, value in added.items():
+        plan.changes.append(Change(_element(joint), line, f"limit {key}", None, value, f"--{key} (added)"))
     _record(plan, joint, expect="continuous", old_upper=joint.limit.upper if joint.limit else None)
-
-
-def _ensure_effort_velocity(document: Document, plan: FixPlan, joint, limit, from_yaml: dict[str, float | None],
-                            options: ContinuousOptions, required: bool) -> bool:
-    """Set effort/velocity: yaml value, else a valid file value, else the option. False if one is missing."""
-    span = document.span(limit) if limit is not None else None
-    complete = True
-    for key, option in (("effort", options.effort), ("velocity", options.velocity)):
-        old = limit.get(key) if limit is not None else None
-        yaml_value = from_yaml.get(key)
-        if yaml_value is not None:
-            new, source = number(yaml_value), options.limits_path.name
-        elif old is not None:
-            continue
-        elif option is not None:
-            new, source = number(option), f"--{key} (added: the joint had none)"
-        else:
-            if required:
-                complete = False
-            else:
-                plan.notes.append(f"note: joint {joint.name} has no {key}; pybullet reads 0 for it. "
-                                  f"Pass --{key} to add one")
-            continue
-        if old is not None and _same(old, new):
-            continue
-        if span is not None:
-            document.set_attribute(span, key, new)
-        plan.changes.append(Change(_element(joint), (limit.sourceline if limit is not None else joint.line) or 0,
-                                   f"limit {key}", old, new, source))
-    return complete
 
 
 def _same(old: str | None, new: str) -> bool:
@@ -179,8 +181,8 @@ def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, op
     for key in ("effort", "velocity"):
         old = limit.get(key) if limit is not None else None
         option = options.effort if key == "effort" else options.velocity
-        if entry_value := yaml_extra[key]:
-            values[key] = number(entry_value)
+        if yaml_extra[key] is not None:
+            values[key] = number(yaml_extra[key])
         elif old is not None:
             values[key] = old
         elif option is not None:
@@ -199,7 +201,7 @@ def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, op
         text = "<limit " + " ".join(f"{k}={q}{values[k]}{q}" for k in ("lower", "upper", "effort", "velocity")) + "/>"
         document.insert_child(document.span(joint.element), [text])
         for key in ("lower", "upper", "effort", "velocity"):
-            origin = source if key in ("lower", "upper") or yaml_extra.get(key) else f"--{key} (added)"
+            origin = source if key in ("lower", "upper") or yaml_extra.get(key) is not None else f"--{key} (added)"
             plan.changes.append(Change(_element(joint), joint.line, f"limit {key}", None, values[key], origin))
     else:
         span = document.span(limit)
@@ -208,7 +210,7 @@ def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, op
             if old is not None and (_same(old, values[key]) or old == values[key]):
                 continue
             document.set_attribute(span, key, values[key])
-            origin = source if key in ("lower", "upper") or yaml_extra.get(key) else f"--{key} (added)"
+            origin = source if key in ("lower", "upper") or yaml_extra.get(key) is not None else f"--{key} (added)"
             plan.changes.append(Change(_element(joint), limit.sourceline or joint.line, f"limit {key}", old,
                                        values[key], origin))
     _record(plan, joint, expect=new_type, lower=entry.lower, upper=entry.upper)
@@ -216,7 +218,9 @@ def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, op
 
 def _full_turn_to_continuous(document: Document, plan: FixPlan, joint) -> None:
     limit = joint.limit
-    if limit is None or limit.lower is None or limit.upper is None or limit.upper - limit.lower < FULL_TURN - 1e-9:
+    if limit is None or limit.lower is None or limit.upper is None:
+        return
+    if limit.upper - limit.lower < FULL_TURN - FULL_TURN_TOLERANCE:
         return
     document.set_attribute(document.span(joint.element), "type", "continuous")
     reason = f"range {limit.upper - limit.lower:.4g} rad covers a full turn (--to-continuous)"

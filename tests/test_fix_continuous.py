@@ -162,3 +162,35 @@ def test_limits_file_errors(cli, tmp_path, write_urdf):
     assert spin.limit.effort == 5.0 and not math.isnan(spin.limit.velocity)
     xacro = cli("fix-continuous", str(ASSETS / "ar3" / "ar3.urdf.xacro"))
     assert xacro.code == 2 and "xacro" in xacro.stderr
+
+
+BARE = WHEEL.replace('<limit lower="-1" upper="1" effort="5" velocity="2"/>', '<limit lower="-100" upper="100"/>')
+
+
+def test_fake_limits_without_effort_remove_the_whole_limit(cli, write_urdf):
+    """The popular advice leaves `<limit lower upper/>`; stripping only lower/upper would leave `<limit/>`,
+    which urdfdom refuses (no effort/velocity). A continuous joint needs no `<limit>`, so it goes."""
+    path = write_urdf(BARE)
+    result = cli("fix-continuous", str(path))
+    assert result.code == 0, result.stderr
+    assert "<limit" not in path.read_text().split('name="spin"')[1].split("</joint>")[0]
+    assert not lint_findings(cli, path, "J006,J007")
+    assert cli("fix-continuous", str(path), "--check").code == 0
+    again = cli("fix-continuous", str(path), "--effort", "5", "--velocity", "2")  # now add real values
+    assert again.code == 0 and load_model(path).joint("spin").limit.effort == 5.0
+    assert load_model(path).joint("spin").limit.velocity == 2.0
+
+
+def test_half_known_effort_velocity_is_reported_not_half_fixed(cli, write_urdf):
+    path = write_urdf(BARE.replace('<limit lower="-100" upper="100"/>', '<limit lower="-100" upper="100" effort="3"/>'))
+    before = path.read_bytes()
+    result = cli("fix-continuous", str(path), "--format", "json")
+    assert result.code == 1
+    (skipped,) = json.loads(result.stdout)["files"][0]["skipped"]
+    assert "pass --velocity" in skipped["reason"] and path.read_bytes() == before
+
+
+def test_full_turn_written_with_eight_digits_of_pi(cli, write_urdf):
+    path = write_urdf(WHEEL.replace('lower="-3.2" upper="3.2"', 'lower="-3.14159265" upper="3.14159265"'))
+    assert cli("fix-continuous", str(path), "--to-continuous").code == 0
+    assert load_model(path).joint("turn").type == "continuous"
