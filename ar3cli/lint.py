@@ -134,11 +134,19 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions) -> FileResult
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
         finding = load_failure(path, shown, exc.message)
-        kept = [f for f in [finding] if _selected(f.rule, rules) and not _file_ignored(shown, f.rule, options)]
-        return FileResult(shown, False, [_override(f, options) for f in kept])
     except RecursionError:
         finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
-        return FileResult(shown, False, [_override(finding, options)] if _selected("F002", rules) else [])
+    else:
+        return _lint_model(model, shown, rules, options)
+    # A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
+    # always reports syntax errors); only an explicit ignore hides it.
+    if matches(finding.rule, options.ignore) or _file_ignored(shown, finding.rule, options):
+        return FileResult(shown, False, [])
+    return FileResult(shown, False, [_override(finding, options)])
+
+
+def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> FileResult:
+    """Run ``rules`` on a loaded model and apply suppressions and severity overrides."""
     context = Context(model, options)
     locator = Locator(model)
     file_ignores = _file_level_ignores(model.source_bytes)

@@ -61,3 +61,10 @@ def test_every_mentioned_command_and_option_exists(doc, line, command, rest):
         if word.startswith("-") and not re.fullmatch(r"-?\d+(\.\d+)?", word):
             flag = word.split("=")[0]
             assert flag in options, f"{doc}:{line}: `ar3cli {command}` has no option {flag}"
+
+
+def test_readme_rule_count_matches_the_registry():
+    from ar3cli.rules import REGISTRY
+
+    counts = re.findall(r"\| (\d+) rules \(", (REPO / "README.md").read_text(encoding="utf-8"))
+    assert counts == [str(len(REGISTRY))]

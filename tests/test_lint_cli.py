@@ -8,7 +8,7 @@ from pathlib import Path
 import pytest
 
 from ar3cli.rules.base import arm
-from tests.conftest import ASSETS, SHARED
+from tests.conftest import ASSETS
 
 ZERO_EFFORT = arm(joint_extra='<limit lower="-1" upper="1" effort="0" velocity="1"/>')  # J008 warning
 NO_LIMIT = arm(joint_extra="")  # J001 error
@@ -40,10 +40,9 @@ def test_text_output_has_location_code_and_summary(cli, write_urdf):
 
 
 def test_sarif_validates_against_the_schema(cli, write_urdf, tmp_path):
-    jsonschema = pytest.importorskip("jsonschema")
-    schema_path = SHARED / "data" / "sarif-schema-2.1.0.json"
-    if not schema_path.is_file():
-        pytest.skip(f"SARIF schema not found at {schema_path}")
+    import jsonschema  # part of the test extra: this test must run, not skip
+
+    schema_path = Path(__file__).parent / "data" / "sarif-schema-2.1.0.json"
     write_urdf(NO_LIMIT)
     (tmp_path / "junk.urdf").write_bytes(b"\x00\xff binary")
     result = cli("lint-urdf", str(tmp_path), "--format", "sarif", cwd=tmp_path)
@@ -233,3 +232,12 @@ def test_sim_rules_run_only_with_sim(cli, write_urdf):
     doc = json.loads(simulated.stdout)  # stdout is JSON alone even though pybullet printed
     (p001,) = [f for f in doc["findings"] if f["rule"] == "P001"]
     assert "does not specify limits" in p001["message"]
+
+
+def test_select_never_hides_a_file_that_cannot_be_loaded(cli, tmp_path):
+    junk = tmp_path / "junk.urdf"
+    junk.write_bytes(b"\x00\xff not xml")
+    selected = cli("lint-urdf", str(junk), "--select", "I", "--format", "json")
+    assert selected.code == 1 and [f["rule"] for f in json.loads(selected.stdout)["findings"]] == ["F002"]
+    ignored = cli("lint-urdf", str(junk), "--select", "I", "--ignore", "F002", "--format", "json")
+    assert ignored.code == 0 and json.loads(ignored.stdout)["findings"] == []
