@@ -317,6 +317,7 @@ class Session:
         multibody (``useMaximalCoordinates``): its contacts are cheaper to solve.
         """
         p = self.p
+        refuse_what_crashes_pybullet(model)
         if flags is None:
             flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_MAINTAIN_LINK_ORDER
         if self_collision == SELF_COLLISION_ALL_PAIRS:
@@ -333,13 +334,26 @@ class Session:
         self.messages.extend(messages)
         if body_id < 0:
             raise UserError(f"{model.path}: pybullet cannot load it: {load_failure_reason(model, messages)}")
-        return Body(self, body_id, model)
+        body = Body(self, body_id, model)
+        too_many = (f"{len(body.joints)} joints; pybullet cannot report the states of a body with "
+                    f"{MAX_PYBULLET_JOINTS} or more (getJointState fails)" if len(body.joints) >= MAX_PYBULLET_JOINTS
+                    else f"{len(body.movable_joints)} movable joints; pybullet silently ignores resetJointState "
+                         f"beyond {MAX_PYBULLET_DOF}" if len(body.movable_joints) > MAX_PYBULLET_DOF else "")
+        if too_many:
+            body.remove()
+            raise UserError(f"{model.path}: {too_many}, so no simulation of it can be trusted")
+        return body
 
     def _write_loadable_copy(self, model: Model) -> Path:
-        """Write the (expanded) document with every mesh/texture filename made absolute."""
+        """Write the (expanded) document with every mesh/texture filename made absolute.
+
+        The copy is indented, one element per line: pybullet's XML parser fails on very long lines
+        (measured: a valid one-line URDF of ~11,000 characters gives XML_ERROR_PARSING_ATTRIBUTE).
+        """
         from lxml import etree
 
         root = copy.deepcopy(model.root)
+        etree.indent(root, space=" ")
         for element in root.iter():
             uri = element.get("filename")
             if not uri:
@@ -354,6 +368,26 @@ class Session:
     def step(self, count: int = 1) -> None:
         for _ in range(count):
             self.p.stepSimulation(physicsClientId=self.client)
+
+
+MAX_PYBULLET_JOINTS = 128
+"""pybullet 3.2.7 loads a body with 128+ joints but getJointState/getLinkState then fail (measured)."""
+MAX_PYBULLET_DOF = 121
+"""pybullet 3.2.7's state vector holds 128 values, 7 of them the base: resetJointState on joint index
+121 or later does nothing and getJointState reads 0 (measured on a 125-joint chain)."""
+MAX_PYBULLET_NAME = 1000
+"""Longest robot/link/joint name handed to pybullet: it segfaults on a robot name of 1040
+characters and on link names of a few thousand (measured, pybullet 3.2.7)."""
+
+
+def refuse_what_crashes_pybullet(model: Model) -> None:
+    """Raise UserError for inputs that crash pybullet's C code (a segfault cannot be caught)."""
+    names = [("robot", model.name or ""), *(("link", link.name) for link in model.links),
+             *(("joint", joint.name) for joint in model.joints)]
+    for kind, name in names:
+        if len(name) > MAX_PYBULLET_NAME:
+            raise UserError(f"{model.path}: {kind} name {name[:20]}... is {len(name)} characters long; pybullet "
+                            f"crashes on names this long: keep names under {MAX_PYBULLET_NAME} characters")
 
 
 def load_failure_reason(model: Model, messages: list[str]) -> str:

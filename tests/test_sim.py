@@ -197,3 +197,31 @@ def test_contacts_min_depth_skips_resting_and_separated_points(session, write_ur
     assert abs(everything[("a", "b")]) < 1e-12 and everything[("a", "c")] == pytest.approx(-0.005, abs=1e-9)
     deep = body.contacts(min_depth=1e-6)
     assert [(a, b) for a, b, _ in deep] == [("a", "c")]
+
+
+def _chain(joints: int, robot_name: str = "chain") -> str:
+    """A one-line URDF chain of ``joints`` revolute joints about x (one line: ~90 characters a joint)."""
+    inertial = '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
+    parts = [f'<link name="l0">{inertial}</link>']
+    parts += [f'<joint name="j{i}" type="revolute"><parent link="l{i - 1}"/><child link="l{i}"/><origin xyz="0 0 0.01"/>'
+              f'<axis xyz="1 0 0"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+              f'<link name="l{i}">{inertial}</link>' for i in range(1, joints + 1)]
+    return f'<robot name="{robot_name}">' + "".join(parts) + "</robot>"
+
+
+def test_one_line_file_of_many_kilobytes_loads_and_every_joint_is_set(session, write_urdf):
+    """pybullet's parser fails on very long lines; the session hands it an indented copy."""
+    body = session.load(load_model(write_urdf(_chain(121))))
+    body.set_positions([0.01] * 121)
+    assert body.positions() == pytest.approx([0.01] * 121)  # the 121st joint too
+
+
+@pytest.mark.parametrize(("joints", "message"), [(125, "125 movable joints"), (130, "130 joints")])
+def test_bodies_beyond_pybullets_state_limits_are_refused(session, write_urdf, joints, message):
+    with pytest.raises(UserError, match=message):
+        session.load(load_model(write_urdf(_chain(joints))))
+
+
+def test_names_that_crash_pybullet_are_refused(session, write_urdf):
+    with pytest.raises(UserError, match="1500 characters long"):
+        session.load(load_model(write_urdf(_chain(1, robot_name="x" * 1500))))
