@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ar3cli import kinematics
+from ar3cli.errors import UserError
 from ar3cli.model import Model
 
 
@@ -90,6 +91,12 @@ def joint_space(body: Any) -> JointSpace:
     """The joint space of a loaded :class:`~ar3cli.sim.Body` (its ``model`` gives the mimic couplings)."""
     joints = body.movable_joints
     driving = tuple(i for i, joint in enumerate(joints) if not is_mimic(joint, body.model))
+    for i in driving:
+        lower, upper = joints[i].sample_range()
+        if not (np.isfinite(lower) and np.isfinite(upper)):
+            where = f"{body.model.path}:{joints[i].urdf.line}" if joints[i].urdf is not None else str(body.model.path)
+            raise UserError(f"{where}: joint '{joints[i].name}' has limits ({lower}, {upper}) that cannot be "
+                            "sampled; give finite numbers (lint-urdf reports this as F007)")
     ranges = np.array([joints[i].sample_range() for i in driving], dtype=float).reshape(-1, 2)
     partial = JointSpace(
         names=tuple(joint.name for joint in joints), driving=driving,

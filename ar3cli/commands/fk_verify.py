@@ -48,11 +48,11 @@ def fk_verify(
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
     model = load_from_options(path, package_path, xacro_arg)
     table = dh_module.load_dh(dh, model) if dh is not None else None
-    if format is OutputFormat.text:
-        log(f"fk-verify: {samples} samples, seed {seed}")
     with Session() as session:
         body = session.load(model, fixed_base=True)
         drawn = fk_compare.sample_configurations(model, body, samples, seed)
+        if format is OutputFormat.text:
+            log(f"fk-verify: {samples} samples, seed {seed}")
         comparison = fk_compare.compare(model, body, drawn)
 
     links_ok = all(e.max_position <= tolerance_m and e.max_orientation <= tolerance_rad for e in comparison.links)
