@@ -49,11 +49,12 @@ def parse_configuration(text: str | None) -> dict[str, float]:
             continue
         name, sep, value = item.partition("=")
         try:
-            values[name.strip()] = float(value)
+            number = float(value)
         except ValueError:
             sep = ""
-        if not sep or not name.strip():
-            raise UserError(f"--config expects NAME=VALUE[,NAME=VALUE...], got {item.strip()!r}")
+        if not sep or not name.strip() or not math.isfinite(number):
+            raise UserError(f"--config expects NAME=VALUE[,NAME=VALUE...] with finite numbers, got {item.strip()!r}")
+        values[name.strip()] = number
     return values
 
 
@@ -88,6 +89,8 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
 
     if not 16 <= width <= 4096 or not 16 <= height <= 4096:
         raise UserError(f"image size {width}x{height} is out of range (16..4096 pixels per side)")
+    if not output.parent.is_dir():
+        raise UserError(f"-o {output}: folder {output.parent} does not exist")
     with Session() as session:
         drawn = showing_collision_geometry(model) if show_collision else model
         body = session.load(drawn, self_collision=SELF_COLLISION_ALL_PAIRS)
@@ -105,7 +108,6 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
         rgb = _snapshot(session, body, width, height, yaw_deg, pitch_deg)
     buffer = io.BytesIO()
     Image.fromarray(rgb).save(buffer, format="PNG")
-    output.parent.mkdir(parents=True, exist_ok=True)
     atomic_write(output, buffer.getvalue())
     return RenderResult(output, width, height, values, contacts)
 

@@ -47,3 +47,7 @@ def test_bad_config_is_one_line_error(cli, tmp_path):
     assert result.stderr.strip().count("\n") == 0 and "joint_9" in result.stderr
     result = cli("render", AR3, "-o", str(tmp_path / "x.png"), "--config", "joint_1")
     assert result.code == 2 and "NAME=VALUE" in result.stderr
+    result = cli("render", AR3, "-o", str(tmp_path / "x.png"), "--config", "joint_2=nan", "--format", "json")
+    assert result.code == 2 and "finite" in result.stderr and not (tmp_path / "x.png").exists()
+    result = cli("render", AR3, "-o", str(tmp_path / "missing" / "x.png"))
+    assert result.code == 2 and "does not exist" in result.stderr and not (tmp_path / "missing").exists()
