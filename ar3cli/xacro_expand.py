@@ -43,11 +43,14 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
     import xacro
     from xacro import substitution_args
 
+    not_found: list[UserError] = []  # xacro wraps what the hook raises; keep ours to re-raise it as is
+
     def find_package(name: str) -> str:
         folder, tried = resolver.find_package(name)
         if folder is None:
-            raise UserError(f"{path}: $(find {name}): package not found; tried {', '.join(tried)}; "
-                            f"pass --package-path {name}=DIR")
+            not_found.append(UserError(f"{path}: $(find {name}): package not found; tried {', '.join(tried)}; "
+                                       f"pass --package-path {name}=DIR"))
+            raise not_found[-1]
         return str(folder)
 
     original_find = substitution_args._eval_find
@@ -59,9 +62,11 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
             text = document.toprettyxml(indent="  ")
     except UserError:
         raise
-    except RecursionError:
-        raise UserError(f"{path}: xacro error: macro recursion too deep") from None
     except Exception as exc:  # xacro raises many types: XacroException, NameError, XML errors...
+        if not_found:
+            raise not_found[-1] from None
+        if isinstance(exc, RecursionError):
+            raise UserError(f"{path}: xacro error: macro recursion too deep") from None
         raise UserError(f"{path}: xacro error: {_one_line(exc)}") from None
     finally:
         substitution_args._eval_find = original_find
@@ -71,7 +76,11 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
 
 
 def _one_line(exc: BaseException) -> str:
-    message = " ".join(str(exc).split()) or type(exc).__name__
+    inner = getattr(exc, "exc", None)  # XacroException wraps the real error and repeats its text
+    if isinstance(inner, OSError) and inner.filename:
+        message = f"cannot read {inner.filename}: {inner.strerror or inner}"
+    else:
+        message = " ".join(str(exc).split()) or type(exc).__name__
     location = _xacro_location()
     return f"{message} (in {location})" if location else message
 

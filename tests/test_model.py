@@ -250,8 +250,19 @@ def test_xacro_unknown_package(tmp_path):
     path.write_text('<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">'
                     '<link name="a"><visual><geometry><mesh filename="$(find nowhere_pkg)/m.stl"/></geometry>'
                     '</visual></link></robot>')
-    with pytest.raises(UserError, match="nowhere_pkg.*--package-path"):
+    with pytest.raises(UserError, match="nowhere_pkg.*--package-path") as info:
         load_model(path)
+    assert str(info.value).count("package not found") == 1 and "class" not in str(info.value)
+
+
+def test_xacro_missing_include_is_said_once(tmp_path):
+    path = tmp_path / "inc.xacro"
+    path.write_text('<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                    '<xacro:include filename="gone.xacro"/><link name="a"/></robot>')
+    with pytest.raises(UserError) as info:
+        load_model(path)
+    assert f"cannot read {tmp_path / 'gone.xacro'}: No such file or directory" in str(info.value)
+    assert str(info.value).count("No such file") == 1
 
 
 def test_joint_type_sets_are_defined_once(write_urdf):
