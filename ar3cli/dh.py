@@ -87,22 +87,10 @@ class DHTable:
 
 def load_dh(path: Path, model: Model) -> DHTable:
     """Read and validate a DH YAML file against ``model``; every problem is a one-line UserError."""
-    import yaml
+    from ar3cli.yamlfile import load_yaml
 
     where = str(path)
-    try:
-        text = Path(path).read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UserError(f"{where}: DH file not found") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UserError(f"{where}: cannot read DH file ({exc.__class__.__name__}: {exc})") from None
-    try:
-        document = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        line = f":{mark.line + 1}" if mark is not None else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise UserError(f"{where}{line}: DH file is not valid YAML: {problem}") from None
+    document = load_yaml(path, "DH file")
     if not isinstance(document, dict):
         raise UserError(f"{where}: DH file must be a YAML mapping with convention, base, tip and joints")
     unknown = sorted(set(map(str, document)) - TOP_KEYS)

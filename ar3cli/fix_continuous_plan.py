@@ -49,18 +49,9 @@ class ContinuousOptions:
 
 def read_joint_limits(path: Path) -> dict[str, YamlLimits]:
     """Parse MoveIt's ``joint_limits.yaml`` (top key ``joint_limits``); errors are one-line UserErrors."""
-    import yaml
+    from ar3cli.yamlfile import load_yaml
 
-    try:
-        data = yaml.safe_load(Path(path).read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise UserError(f"{path}: cannot read: {exc}") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
-        raise UserError(f"{where}: not valid YAML: {getattr(exc, 'problem', None) or exc}") from None
+    data = load_yaml(path, "joint limits file")
     if not isinstance(data, dict) or not isinstance(data.get("joint_limits"), dict):
         raise UserError(f"{path}: expected MoveIt's format with a top-level 'joint_limits:' mapping")
     limits: dict[str, YamlLimits] = {}
@@ -72,7 +63,19 @@ def read_joint_limits(path: Path) -> dict[str, YamlLimits]:
             _yaml_number(path, name, entry, "max_position", "has_position_limits"),
             _yaml_number(path, name, entry, "max_velocity", "has_velocity_limits"),
             _yaml_number(path, name, entry, "max_effort", "has_effort_limits"))
+        _check_position_limits(path, str(name), entry, limits[str(name)])
     return limits
+
+
+def _check_position_limits(path: Path, joint: str, entry: dict, limits: YamlLimits) -> None:
+    """A joint that claims position limits must give both, in order (else the fix would be wrong)."""
+    if entry.get("has_position_limits") is not True:
+        return
+    if limits.lower is None or limits.upper is None:
+        raise UserError(f"{path}: joint_limits.{joint} has has_position_limits: true but no min_position/max_position")
+    if limits.lower > limits.upper:
+        raise UserError(f"{path}: joint_limits.{joint}: min_position {limits.lower} is above max_position "
+                        f"{limits.upper}")
 
 
 def _yaml_number(path: Path, joint: str, entry: dict, key: str, flag: str) -> float | None:

@@ -162,6 +162,13 @@ def test_limits_file_errors(cli, tmp_path, write_urdf):
     assert spin.limit.effort == 5.0 and not math.isnan(spin.limit.velocity)
     xacro = cli("fix-continuous", str(ASSETS / "ar3" / "ar3.urdf.xacro"))
     assert xacro.code == 2 and "xacro" in xacro.stderr
+    before = path.read_bytes()
+    for text, message in [("joint_limits:\n  spin: {has_position_limits: true, min_position: 2, max_position: 1}\n",
+                           "is above max_position"),
+                          ("joint_limits:\n  spin: {has_position_limits: true}\n", "no min_position/max_position")]:
+        bad.write_text(text)
+        result = cli("fix-continuous", str(path), "--limits-from", str(bad))
+        assert result.code == 2 and message in result.stderr and path.read_bytes() == before
 
 
 BARE = WHEEL.replace('<limit lower="-1" upper="1" effort="5" velocity="2"/>', '<limit lower="-100" upper="100"/>')
