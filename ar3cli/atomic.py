@@ -9,6 +9,7 @@ new one, never a mix. Every file ar3cli writes (fixed URDFs, SRDFs, pictures, GI
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 import time
 from pathlib import Path
@@ -35,6 +36,9 @@ def atomic_write(path: Path, data: bytes, validate=None) -> None:
     directory = path.parent
     if path.is_dir():
         raise UserError(f"{path}: is a directory; give a file name")
+    if path.exists() and not path.stat().st_mode & stat.S_IWUSR:
+        # a rename would replace it anyway (it needs only a writable folder): respect the intent
+        raise UserError(f"{path}: is read-only; make it writable first (chmod u+w) if it should change")
     try:
         mode = path.stat().st_mode & 0o7777
     except FileNotFoundError:

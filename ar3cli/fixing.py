@@ -94,8 +94,10 @@ def number(value: float) -> str:
 
 
 def refuse_xacro(paths: list[Path]) -> None:
+    from ar3cli.xacro_expand import is_xacro
+
     for path in paths:
-        if path.name.endswith(".xacro"):
+        if is_xacro(path):
             raise UserError(f"{path}: is a xacro file; fixing the generated URDF would not fix the source. "
                             "Fix the .xacro by hand (the expanded-URDF output of this command with --diff shows "
                             "what to change), or run this command on a URDF")
@@ -103,7 +105,11 @@ def refuse_xacro(paths: list[Path]) -> None:
 
 def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, check: bool, output: Path | None,
               fmt: OutputFormat, package_path: list[str] | None, verifier: Verifier | None = None) -> int:
-    """Run ``fixer`` on every path and report; returns the exit code."""
+    """Run ``fixer`` on every path and report; returns the exit code.
+
+    Every file is loaded and planned before the first write: a bad second input stops the run
+    with no file changed, instead of after the first one was rewritten.
+    """
     from ar3cli.options import load_from_options
 
     if not paths:
@@ -111,7 +117,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     if output is not None and len(paths) != 1:
         raise UserError("-o/--output takes exactly one input file")
     refuse_xacro(paths)
-    results: list[FileResult] = []
+    planned: list[tuple[FileResult, bytes]] = []
     for path in paths:
         model = load_from_options(path, package_path, None)
         document = Document(model.source_bytes)
@@ -123,7 +129,9 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
             _check_parses(path, new)
         if diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
-        target = output or path
+        planned.append((result, new))
+    for result, new in planned:
+        target = output or result.path
         if not diff and not check and (result.changed or output is not None):
             def validate(temp: Path, result: FileResult = result) -> None:
                 new_model = load_from_options(temp, package_path, None)
@@ -132,8 +140,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
 
             atomic_write(target, new, validate)
             result.written = target
-        results.append(result)
-    return _report(command, results, diff=diff, check=check, fmt=fmt)
+    return _report(command, [result for result, _ in planned], diff=diff, check=check, fmt=fmt)
 
 
 def _check_parses(path: Path, data: bytes) -> None:
@@ -148,7 +155,12 @@ def unified_diff(path: Path, old: bytes, new: bytes) -> str:
 
     return "".join(difflib.unified_diff(decode_text(old).splitlines(keepends=True),
                                         decode_text(new).splitlines(keepends=True),
-                                        fromfile=f"a/{path}", tofile=f"b/{path}"))
+                                        fromfile=_diff_name("a", path), tofile=_diff_name("b", path)))
+
+
+def _diff_name(side: str, path: Path) -> str:
+    """``a/urdf/robot.urdf`` for a relative path (as git writes it); an absolute path as it is."""
+    return str(path) if Path(path).is_absolute() else f"{side}/{path}"
 
 
 def _report(command: str, results: list[FileResult], *, diff: bool, check: bool, fmt: OutputFormat) -> int:
@@ -180,7 +192,9 @@ def _report(command: str, results: list[FileResult], *, diff: bool, check: bool,
             table.columns, table.rows = table.columns[1:], [row[1:] for row in table.rows]
     lines = [note for r in results for note in r.plan.notes]
     for r in results:
-        if not r.changed:
+        if not r.changed and r.plan.skipped:
+            lines.append(f"{r.path}: nothing written ({len(r.plan.skipped)} element(s) not fixed, see above)")
+        elif not r.changed:
             lines.append(f"{r.path}: nothing to change")
         elif r.written:
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) changed, written to {r.written}")

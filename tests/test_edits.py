@@ -186,3 +186,16 @@ def test_atomic_write_into_read_only_folder_is_a_user_error(tmp_path):
             atomic_write(tmp_path / "ro" / "x.urdf", b"x")
     finally:
         (tmp_path / "ro").chmod(0o700)
+
+
+def test_atomic_write_respects_a_read_only_file(tmp_path):
+    import pytest
+
+    from ar3cli.errors import UserError
+
+    target = tmp_path / "robot.urdf"
+    target.write_bytes(b"old")
+    target.chmod(0o444)
+    with pytest.raises(UserError, match="is read-only"):
+        atomic_write(target, b"new")
+    assert target.read_bytes() == b"old" and not stale_temps(tmp_path)
