@@ -207,5 +207,17 @@ def pybullet_joint_type(ctx) -> Iterator[Hit]:
             yield Hit(f"joint '{joint.name}' type '{joint.type}' is a PyBullet extension, not URDF", joint.element)
 
 
+@rule("S011", "no-links", "error", "<robot> has no links",
+      why="""A robot is a tree of links. urdfdom refuses a file without one ("No link elements found in
+      urdf file") and PyBullet cannot load it; an empty <robot> is usually a xacro argument or macro
+      that expanded to nothing.""",
+      fix="Add the links, or check the xacro arguments that should have produced them.",
+      bad='<?xml version="1.0"?>\n<robot name="empty"/>\n',
+      good=robot('<link name="base"/>'))
+def no_links(ctx) -> Iterator[Hit]:
+    if not ctx.model.links:
+        yield Hit("<robot> has no <link> elements", ctx.model.root)
+
+
 RULES = (robot_name, duplicate_link, duplicate_joint, missing_link, several_roots, not_a_tree,
-         unknown_joint_reference, undefined_material, joint_type, pybullet_joint_type)
+         unknown_joint_reference, undefined_material, joint_type, pybullet_joint_type, no_links)
