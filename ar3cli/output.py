@@ -107,12 +107,39 @@ def plain_table(table: Table) -> str:
     return "\n".join(out) + "\n"
 
 
+NARROW_TERMINAL = 100
+"""Below this many columns a wide table would split words and numbers: rows are printed as blocks."""
+
+
+def render_rows_as_blocks(table: Table, out) -> None:
+    """One block per row for narrow terminals: the short cells on one line, each long cell indented
+    below it and wrapped by the terminal (as ruff prints diagnostics)."""
+    from rich.padding import Padding
+    from rich.text import Text
+
+    rows = [[format_cell(value) for value in row] for row in table.rows]
+    short = [index for index, column in enumerate(table.columns)
+             if column in table.nowrap_columns or column in table.numeric_columns or column == table.status_column
+             or max((len(row[index]) for row in rows), default=0) <= 16]
+    if table.title:
+        out.print(Text(table.title, style="bold"))
+    for row in rows:
+        out.print(Text("  ".join(row[index] for index in short if row[index])))
+        for index, column in enumerate(table.columns):
+            if index not in short and row[index]:
+                out.print(Padding(Text(f"{column}: {row[index]}"), (0, 0, 0, 4)))
+
+
 def render_table(table: Table, out=None) -> None:
-    """Print one :class:`Table`: through rich on a terminal, as :func:`plain_table` elsewhere."""
+    """Print one :class:`Table`: through rich on a terminal (as blocks when it is narrow), as
+    :func:`plain_table` elsewhere."""
     out = out or console()
     if not out.is_terminal:
         out.file.write(plain_table(table))
         out.file.flush()
+        return
+    if out.width < NARROW_TERMINAL and len(table.columns) > 3:
+        render_rows_as_blocks(table, out)
         return
     from rich import box
     from rich.table import Table as RichTable
@@ -123,8 +150,9 @@ def render_table(table: Table, out=None) -> None:
                            box=box.ASCII2 if plain else box.ROUNDED, title_justify="left",
                            caption_justify="left", header_style="" if plain else "bold")
     for column in table.columns:
+        keep_whole = column in table.nowrap_columns or column in table.numeric_columns or column == table.status_column
         rich_table.add_column(column, justify="right" if column in table.numeric_columns else "left",
-                              overflow="fold", no_wrap=column in table.nowrap_columns)
+                              overflow="fold", no_wrap=keep_whole, min_width=max(len(word) for word in column.split()))
     status_index = table.columns.index(table.status_column) if table.status_column in table.columns else -1
     for row in table.rows:
         cells = []
