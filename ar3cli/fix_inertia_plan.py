@@ -69,7 +69,7 @@ def make_fixer(options: InertiaOptions):
     return fix
 
 
-def _select(model, options: InertiaOptions, cache: dict) -> dict[str, str]:
+def _select(model, options: InertiaOptions) -> dict[str, str]:
     for name in [*(options.links or []), *options.masses]:
         if model.link(name) is None:
             raise UserError(f"{model.path}: no link named {name!r}")
@@ -77,13 +77,13 @@ def _select(model, options: InertiaOptions, cache: dict) -> dict[str, str]:
         return {link.name: "--all" for link in model.links}
     if options.links:
         return {name: "--links" for name in options.links}
-    return inertia.links_needing_inertia(model, cache)
+    return inertia.links_needing_inertia(model)
 
 
 def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
     plan = FixPlan()
     cache: dict = {}
-    selected = _select(model, options, cache)
+    selected = _select(model, options)
     targets: list[_Target] = []
     for name, reason in selected.items():
         link = model.link(name)

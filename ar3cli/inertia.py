@@ -195,12 +195,11 @@ def is_frame_link(model: Model, link: Link) -> bool:
     return not link.has_geometry and joint is not None and joint.type == "fixed"
 
 
-def links_needing_inertia(model: Model, cache: dict | None = None) -> dict[str, str]:
+def links_needing_inertia(model: Model) -> dict[str, str]:
     """``{link name: "CODE name: message"}`` for every link the lint inertia rules (I001-I007) flag.
 
     The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
     so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
-    ``cache`` is accepted for callers that share a mesh cache; the rules keep their own.
     """
     from ar3cli.lint import Context, LintOptions, suppressed_inline
     from ar3cli.rules.inertia import RULES

@@ -21,13 +21,13 @@ def _moving_links(model) -> dict[str, object]:
 
 
 @lru_cache(maxsize=4096)
-def _moments(tensor: tuple[float, ...]) -> tuple[float, float, float]:
+def tensor_moments(tensor: tuple[float, ...]) -> tuple[float, float, float]:
     """Principal moments of an (ixx, ixy, ixz, iyy, iyz, izz) tensor; cached, as I004, I005 and I007 all ask."""
     ixx, ixy, ixz, iyy, iyz, izz = tensor
     return symmetric_eigenvalues(((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz)))
 
 
-def _finite(tensor) -> bool:
+def finite_tensor(tensor) -> bool:
     return tensor is not None and all(math.isfinite(v) for v in tensor)
 
 
@@ -94,9 +94,9 @@ def _tensor_hits(ctx, test):
     """Yield (link, inertial, moments) for links with a finite, non-zero tensor where ``test`` fails."""
     for link in ctx.model.links:
         inertial = link.inertial
-        if inertial is None or not _finite(inertial.tensor) or not any(inertial.tensor):
+        if inertial is None or not finite_tensor(inertial.tensor) or not any(inertial.tensor):
             continue
-        moments = _moments(inertial.tensor)
+        moments = tensor_moments(inertial.tensor)
         if not test(inertial, moments):
             yield link, inertial, moments
 
@@ -161,14 +161,14 @@ def inertia_zero(ctx) -> Iterator[Hit]:
 def inertia_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
         inertial = link.inertial
-        if inertial is None or not _finite(inertial.tensor) or not (inertial.mass or 0) > 0 \
+        if inertial is None or not finite_tensor(inertial.tensor) or not (inertial.mass or 0) > 0 \
                 or not math.isfinite(inertial.mass):
             continue
         bounds = ctx.link_bounds(link)
         if bounds is None:
             continue
         half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
-        moments = _moments(inertial.tensor)
+        moments = tensor_moments(inertial.tensor)
         if half_diagonal <= 0 or moments[-1] <= 0:
             continue
         gyration = math.sqrt(moments[-1] / inertial.mass)

@@ -115,7 +115,7 @@ def sim_inertia_differs(ctx) -> Iterator[Hit]:
 
     A per-link finding would bury a clean model in rows: the default load replaces *every* tensor.
     """
-    from ar3cli.rules.inertia import _finite, _moments
+    from ar3cli.rules.inertia import finite_tensor, tensor_moments
 
     changed: list[tuple[float, str, object]] = []  # (relative difference, description, element)
     with _loaded(ctx, fixed_base=False, flags=ctx.session.p.URDF_MAINTAIN_LINK_ORDER) as body:
@@ -123,12 +123,12 @@ def sim_inertia_differs(ctx) -> Iterator[Hit]:
             return
         for link in ctx.model.links:
             inertial = link.inertial
-            if link.name not in body.link_index or inertial is None or not _finite(inertial.tensor) \
+            if link.name not in body.link_index or inertial is None or not finite_tensor(inertial.tensor) \
                     or not (inertial.mass or 0) > 0:
                 continue
             dynamics = body.dynamics(link.name)
             used_mass, used = dynamics.mass, sorted(dynamics.inertia_diagonal)
-            file_moments = sorted(float(m) for m in _moments(inertial.tensor))
+            file_moments = sorted(float(m) for m in tensor_moments(inertial.tensor))
             parts = []
             if _differs(used_mass, inertial.mass):
                 parts.append(f"mass {inertial.mass:.4g} kg in the file, {used_mass:.4g} kg in PyBullet")
