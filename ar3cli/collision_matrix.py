@@ -155,8 +155,9 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
                                  path, hint="disable the pair with setCollisionFilterPair (see --pybullet-filter)"))
         if result.collisions == 0 and result.limit_hits:
             found.append(Finding("contact-only-at-limits", Severity.INFO,
-                                 f"{label} never collided in {result.samples} uniform samples but do at "
-                                 f"{', '.join(result.limit_hits)}; kept enabled (MoveIt would disable it)",
+                                 f"{label} never collided in {result.samples} uniform samples but collide in the "
+                                 f"limit configuration(s) {'; '.join(result.limit_hits)}; kept enabled (MoveIt "
+                                 "would disable the pair)",
                                  path))
     return found
 

@@ -42,6 +42,15 @@ def cli():
     return run_cli
 
 
+@pytest.fixture
+def session():
+    """A fresh PyBullet session (DIRECT) for one test, closed afterwards."""
+    from ar3cli.sim import Session
+
+    with Session() as opened:
+        yield opened
+
+
 @pytest.fixture(scope="session")
 def pybullet_data_dir() -> Path:
     import pybullet_data

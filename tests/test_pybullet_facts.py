@@ -23,12 +23,6 @@ TWO_LINKS = """<robot name="t"><link name="a"><inertial><mass value="1"/>
 INERTIAL = '<inertial><mass value="0.5"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
 
 
-@pytest.fixture
-def session():
-    with Session() as s:
-        yield s
-
-
 def test_link_without_inertial_gets_one_kilogram(session, write_urdf):
     model = load_model(write_urdf(TWO_LINKS.format(type="revolute", inertial="",
                                                    limit='<limit lower="-1" upper="1" effort="1" velocity="1"/>')))

@@ -32,12 +32,6 @@ OFFSET_COM = """<?xml version="1.0"?>
 """
 
 
-@pytest.fixture
-def session():
-    with Session() as s:
-        yield s
-
-
 def test_joint_table_knows_continuous_from_urdf(session, write_urdf):
     body = session.load(load_model(write_urdf(OFFSET_COM)))
     (hinge,) = body.movable_joints

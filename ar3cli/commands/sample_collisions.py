@@ -48,10 +48,12 @@ def sample_collisions(
 
     Pairs are adjacent / default (touching at home) / always / never / sometimes; 'never' comes with
     the 95% upper bound on its collision probability, 'sometimes' with a Wilson 95% interval. The
-    home pose and every joint at its limits are checked too. Exit 0 when the matrix was computed.
+    home pose and every driving joint at its limits (mimic joints follow) are checked too. Exit 0 when the matrix was computed.
     """
     from ar3cli import collision_matrix as cm
-    from ar3cli.collisions import Checker, collision_links
+    from ar3cli.adjacency import collision_links
+    from ar3cli.adjacency import adjacent_pairs
+    from ar3cli.collisions import Checker
 
     model = _load(path, package_path, xacro_arg)
     if len(collision_links(model)) < 2:
@@ -60,7 +62,7 @@ def sample_collisions(
     with Checker(model) as checker:
         run = _run(checker, source, samples, seed, jobs)
     links, pairs = checker.links, checker.pairs
-    adjacent = cm.adjacent_pairs(model, links)
+    adjacent = adjacent_pairs(model, links)
     results = cm.classify(links, pairs, run["counts"], samples, adjacent, run["home_hits"], run["limit_hits"],
                           always_threshold)
     warnings = cm.findings(model, results, links, always_threshold)
@@ -96,7 +98,7 @@ def _source(model, package_path, xacro_arg):
 
 
 def _no_pairs_message(model) -> str:
-    from ar3cli.collisions import collision_links
+    from ar3cli.adjacency import collision_links
 
     solid = collision_links(model)
     visual_only = [link.name for link in model.links if link.visuals and link.name not in solid]
@@ -113,7 +115,8 @@ def _no_pairs_message(model) -> str:
 
 def _run(checker, source, samples: int, seed: int, jobs: int) -> dict:
     """Home + limit configurations, then the uniform samples (counted, timed, with progress)."""
-    from ar3cli.collisions import count_collisions, limit_configurations, sample_configurations
+    from ar3cli.collisions import count_collisions
+    from ar3cli.sampling import limit_configurations, sample_configurations
 
     space = checker.joint_space()
     home_hits: set[int] = set()
@@ -199,7 +202,7 @@ def _report(model, results, links, pairs, warnings, run, samples, seed, jobs, th
     lines = [
         f"seed {seed}: {samples} uniform samples + {run['limits']} home/limit configurations, "
         f"{len(pairs)} pairs of {len(links)} links with collision geometry, {run['dof']} joints",
-        f"{summary}; {sum(counts[c] for c in cm.DISABLED)} pairs to disable",
+        f"{summary}; {_count(sum(counts[c] for c in cm.DISABLED), 'pair')} to disable",
         f"'never' means: collision probability below {never_bound:.2g} with 95% confidence (exact bound, "
         f"~3/N); more samples tighten it",
         f"{rate:,.0f} configurations/s with {jobs} job{'s' if jobs != 1 else ''}" if rate else "",
@@ -209,7 +212,12 @@ def _report(model, results, links, pairs, warnings, run, samples, seed, jobs, th
                   lines=[line for line in lines if line])
 
 
-def _tolerance() -> float:
-    from ar3cli.collisions import CONTACT_TOLERANCE
+def _count(number: int, noun: str) -> str:
+    """``1 pair``, ``3 pairs``."""
+    return f"{number} {noun}{'' if number == 1 else 's'}"
 
-    return CONTACT_TOLERANCE
+
+def _tolerance() -> float:
+    from ar3cli.sim import PENETRATION_TOLERANCE
+
+    return PENETRATION_TOLERANCE
