@@ -1,7 +1,8 @@
 """The Typer application: thin commands that parse options, call the core, render, and exit.
 
 Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad input gets a one-line
-``ar3cli: error: ...`` on stderr, never a traceback; set ``AR3CLI_DEBUG=1`` to see one for bugs).
+``ar3cli: error: ...`` on stderr, never a traceback), 3 a bug in ar3cli (one line too; set
+``AR3CLI_DEBUG=1`` to see the traceback).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ from ar3cli.commands.lint_urdf import lint_urdf
 from ar3cli.commands.fix_inertia import fix_inertia
 from ar3cli.commands.fix_continuous import fix_continuous
 from ar3cli.commands.sample_collisions import sample_collisions
-from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.errors import EXIT_INTERNAL, EXIT_USAGE, UserError
 
 app = typer.Typer(
     name="ar3cli",
@@ -104,4 +105,4 @@ def main(argv: list[str] | None = None) -> None:
             raise
         print(f"ar3cli: internal error: {type(exc).__name__}: {exc} (rerun with AR3CLI_DEBUG=1 for a traceback "
               "and report it)", file=sys.stderr)
-        sys.exit(EXIT_USAGE + 1)
+        sys.exit(EXIT_INTERNAL)

@@ -9,6 +9,8 @@ from __future__ import annotations
 EXIT_OK = 0
 EXIT_PROBLEMS = 1
 EXIT_USAGE = 2
+EXIT_INTERNAL = 3
+"""A bug in ar3cli (an unexpected exception), reported in one line."""
 
 
 class UserError(Exception):
