@@ -57,6 +57,18 @@ def sim_load_failed(ctx) -> Iterator[Hit]:
     body.remove()
 
 
+def _stacked_boxes(tip_z: float) -> str:
+    """P002's example: base and tip boxes joined through a small middle link; overlapping when tip_z < 0."""
+    return robot(f"""
+          <link name="base">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+          <link name="mid">{LINK_INERTIAL}<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link>
+          <link name="tip">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.3"/>
+            <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 {tip_z}"/>
+            <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>""")
+
+
 @rule("P002", "sim-self-collision-home", "warning", "Links collide at the home pose",
       why="""Two links that are not adjacent but interpenetrate (deeper than 1 µm) at the home pose
       (all joints at 0, or mid-range where 0 is outside the limits; mimic joints following) mean
@@ -66,22 +78,7 @@ def sim_load_failed(ctx) -> Iterator[Hit]:
       without collision geometry (their overlap is by construction).""",
       fix="Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
           "(SRDF / setCollisionFilterPair).",
-      bad=robot(f"""
-          <link name="base">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <link name="mid">{LINK_INERTIAL}<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link>
-          <link name="tip">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.3"/>
-            <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 -0.25"/>
-            <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
-      good=robot(f"""
-          <link name="base">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <link name="mid">{LINK_INERTIAL}<collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link>
-          <link name="tip">{LINK_INERTIAL}<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
-          <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.3"/>
-            <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
-          <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 0.25"/>
-            <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
+      bad=_stacked_boxes(tip_z=-0.25), good=_stacked_boxes(tip_z=0.25),
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.adjacency import nonadjacent_collisions
