@@ -128,18 +128,18 @@ def sim_inertia_differs(ctx) -> Iterator[Hit]:
             file_moments = sorted(float(m) for m in tensor_moments(inertial.tensor))
             parts = []
             if _differs(used_mass, inertial.mass):
-                parts.append(f"mass {inertial.mass:.4g} kg in the file, {used_mass:.4g} kg in PyBullet")
+                parts.append(f"mass {inertial.mass:.4g} kg -> {used_mass:.4g} kg")
             if any(_differs(u, f) for u, f in zip(used, file_moments)):
-                parts.append("principal moments " + "(" + ", ".join(f"{m:.3g}" for m in file_moments) + ") in the file, "
-                             + "(" + ", ".join(f"{m:.3g}" for m in used) + ") used by PyBullet's default load")
+                parts.append("principal moments (" + ", ".join(f"{m:.3g}" for m in file_moments) + ") -> ("
+                             + ", ".join(f"{m:.3g}" for m in used) + ")")
             if parts:
                 worst = max(_relative(u, f) for u, f in zip([used_mass, *used], [inertial.mass, *file_moments]))
                 changed.append((worst, f"link '{link.name}': " + "; ".join(parts), inertial.element))
     if changed:
         worst, description, element = max(changed, key=lambda item: item[0])
-        others = len(changed) - 1
-        more = f" and {others} other link{'s' if others != 1 else ''}" if others else ""
-        yield Hit(f"{description}{more} (largest difference {worst:.0%})", element)
+        count = f"{len(changed)} link{'s' if len(changed) != 1 else ''}"
+        yield Hit(f"PyBullet's default load (without URDF_USE_INERTIA_FROM_FILE) changes the mass properties of "
+                  f"{count}; most: {description} ({worst:.0%})", element)
 
 
 def _relative(used: float, declared: float) -> float:
