@@ -24,6 +24,22 @@ SLOW_WRITE_ENV = "AR3CLI_TEST_SLOW_WRITE"
 the process mid-write and check that the target is intact."""
 
 
+def check_writable(path: Path) -> Path:
+    """The real target (symlinks followed) if ar3cli may replace it; UserError otherwise.
+
+    Callers that write several files check them all first, so a run writes all or nothing.
+    """
+    path = Path(os.path.realpath(path))
+    if path.is_dir():
+        raise UserError(f"{path}: is a directory; give a file name")
+    if not path.parent.is_dir():
+        raise UserError(f"{path}: folder {path.parent} does not exist")
+    if path.exists() and not path.stat().st_mode & stat.S_IWUSR:
+        # a rename would replace it anyway (it needs only a writable folder): respect the intent
+        raise UserError(f"{path}: is read-only; make it writable first (chmod u+w) if it should change")
+    return path
+
+
 def atomic_write(path: Path, data: bytes, validate=None) -> None:
     """Replace ``path`` with ``data`` atomically; ``validate(temp_path)`` may raise to abort.
 
@@ -32,13 +48,8 @@ def atomic_write(path: Path, data: bytes, validate=None) -> None:
     removed and the original is untouched; an OS error becomes a one-line :class:`UserError`.
     A symlink is written through (its target changes, the link stays a link).
     """
-    path = Path(os.path.realpath(path))
+    path = check_writable(path)
     directory = path.parent
-    if path.is_dir():
-        raise UserError(f"{path}: is a directory; give a file name")
-    if path.exists() and not path.stat().st_mode & stat.S_IWUSR:
-        # a rename would replace it anyway (it needs only a writable folder): respect the intent
-        raise UserError(f"{path}: is read-only; make it writable first (chmod u+w) if it should change")
     try:
         mode = path.stat().st_mode & 0o7777
     except FileNotFoundError:

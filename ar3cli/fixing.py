@@ -17,7 +17,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ar3cli.atomic import atomic_write
+from ar3cli.atomic import atomic_write, check_writable
 from ar3cli.edits import Document
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
 from ar3cli.output import OutputFormat, Report, Table, render
@@ -130,6 +130,10 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
         if diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
         planned.append((result, new))
+    if not diff and not check:
+        for result, _ in planned:
+            if result.changed or output is not None:
+                check_writable(output or result.path)
     for result, new in planned:
         target = output or result.path
         if not diff and not check and (result.changed or output is not None):

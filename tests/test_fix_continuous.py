@@ -201,3 +201,13 @@ def test_full_turn_written_with_eight_digits_of_pi(cli, write_urdf):
     path = write_urdf(WHEEL.replace('lower="-3.2" upper="3.2"', 'lower="-3.14159265" upper="3.14159265"'))
     assert cli("fix-continuous", str(path), "--to-continuous").code == 0
     assert load_model(path).joint("turn").type == "continuous"
+
+
+def test_a_read_only_second_input_stops_the_run_before_any_write(cli, tmp_path):
+    first, second = tmp_path / "a.urdf", tmp_path / "b.urdf"
+    for path in (first, second):
+        path.write_text(BARE)
+    second.chmod(0o444)
+    result = cli("fix-continuous", str(first), str(second), "--no-verify")
+    assert result.code == 2 and "is read-only" in result.stderr
+    assert first.read_text() == BARE  # all or nothing
