@@ -66,7 +66,7 @@ def console(stderr: bool = False):
 
     stream = sys.stderr if stderr else sys.stdout
     plain = bool(os.environ.get("NO_COLOR")) or not stream.isatty()
-    return Console(file=stream, no_color=plain, highlight=False, soft_wrap=False,
+    return Console(file=stream, no_color=plain, highlight=False, soft_wrap=not stream.isatty(),
                    width=None if stream.isatty() else 160, safe_box=True,
                    force_terminal=False if plain else None)
 
