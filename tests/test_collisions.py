@@ -163,6 +163,11 @@ def test_png_heat_map(cli, tmp_path):
     from ar3cli.heatmap_png import CATEGORY_COLOURS
 
     assert CATEGORY_COLOURS["adjacent"] in colours and CATEGORY_COLOURS["never"] in colours
+    srdf = tmp_path / "a.srdf"
+    for bad, message in [(tmp_path / "nodir" / "m.png", "does not exist"), (tmp_path / "m.gif", "must end in .png")]:
+        refused = cli("sample-collisions", str(ASSETS / "ar3" / "ar3.urdf"), "-n", "10", "--srdf", str(srdf),
+                      "--png", str(bad))
+        assert refused.code == 2 and message in refused.stderr and not srdf.exists()  # nothing written
 
 
 TRANSPARENT = """<?xml version="1.0"?>

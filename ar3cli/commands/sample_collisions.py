@@ -55,6 +55,7 @@ def sample_collisions(
     from ar3cli.adjacency import adjacent_pairs
     from ar3cli.collisions import Checker
 
+    _check_outputs(srdf, pybullet_filter, png)
     model = _load(path, package_path, xacro_arg)
     if len(collision_links(model)) < 2:
         raise UserError(_no_pairs_message(model))
@@ -79,6 +80,17 @@ def sample_collisions(
                                                              f"{samples} samples, seed {seed}"))
     finish(_report(model, results, links, pairs, warnings, run, samples, seed, jobs, always_threshold, format),
            format)
+
+
+def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | None) -> None:
+    """Refuse unusable output paths before minutes of sampling, not after."""
+    from ar3cli.atomic import check_writable
+
+    if png is not None and png.suffix.lower() != ".png":
+        raise UserError(f"--png {png}: the file name must end in .png")
+    for target in (srdf, pybullet_filter, png):
+        if target is not None:
+            check_writable(target)
 
 
 def _load(path, package_path, xacro_arg):
