@@ -104,14 +104,14 @@ def main() -> None:
     empty = median([*lint, *map(str, models)], repeats, empty_cache=True)
     text = median([*lint, *map(str, models)], repeats)
     as_json = median([*lint, "--format", "json", *map(str, models)], repeats)
-    print(f"\n{len(models)} pybullet_data models (random_urdfs excluded), one ar3cli call (median of {repeats}):")
+    print(f"\n{len(models)} pybullet_data models (random_urdfs excluded), a single call (median of {repeats}):")
     print(f"  ar3cli lint-urdf, empty mesh cache    {empty}")
     print(f"  ar3cli lint-urdf (text table)         {text}")
     print(f"  ar3cli lint-urdf --format json        {as_json}")
     if check_urdf:
         loop = statistics.median(check_urdf_loop(check_urdf, models) for _ in range(repeats))
         print(f"  check_urdf, once per file             {loop:6.3f} s wall   check_urdf loop / ar3cli: "
-              f"{loop / text.wall:.2f} (text), {loop / as_json.wall:.2f} (json); > 1 means ar3cli is faster")
+              f"{loop / text.wall:.2f} (text), {loop / as_json.wall:.2f} (json); > 1 means the single call is faster")
     else:
         print("  check_urdf not installed (apt-get install liburdfdom-tools): no baseline")
     print(f"\nafter: {load()}")
