@@ -24,11 +24,11 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
-from ar3cli.adjacency import adjacent_pairs, direct_parent_child
+from ar3cli.adjacency import direct_parent_child
 from ar3cli.findings import Finding, Severity
 from ar3cli.model import Model
 
-__all__ = ["adjacent_pairs", "classify", "direct_parent_child", "findings", "srdf_bytes"]
+__all__ = ["classify", "findings", "srdf_bytes"]
 
 CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
 DISABLED = ("adjacent", "default", "always", "never")

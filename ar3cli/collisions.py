@@ -41,14 +41,11 @@ import numpy as np
 from ar3cli.adjacency import collision_links
 from ar3cli.errors import UserError
 from ar3cli.model import Model, load_model
-from ar3cli.sampling import JointSpace, joint_space, limit_configurations, sample_configurations
+from ar3cli.sampling import JointSpace, joint_space
 from ar3cli.sim import PENETRATION_TOLERANCE
 
-__all__ = ["Checker", "JointSpace", "ModelSource", "collision_links", "count_collisions", "limit_configurations",
-           "sample_configurations"]
+__all__ = ["Checker", "ModelSource", "count_collisions"]
 
-CONTACT_TOLERANCE = PENETRATION_TOLERANCE
-"""m: a pair collides when its deepest contact point penetrates more than this (the shared constant)."""
 CONTACT_BREAKING_THRESHOLD = 1e-5
 """m: Bullet drops manifold points that drifted more than this; small, so teleports leave no stale points."""
 
@@ -122,7 +119,7 @@ class Checker:
     def _check(self, configs: np.ndarray, hits_out: set[int] | None = None) -> np.ndarray:
         p, client, body = self.session.p, self.session.client, self.body.id
         reset, detect, contacts = p.resetJointStatesMultiDof, p.performCollisionDetection, p.getContactPoints
-        lookup, indices, tolerance = self._lookup, self._joint_indices, -CONTACT_TOLERANCE
+        lookup, indices, tolerance = self._lookup, self._joint_indices, -PENETRATION_TOLERANCE
         counts = [0] * len(self.pairs)
         targets = configs[:, :, None].tolist()  # [[q0], [q1], ...] per row, as resetJointStatesMultiDof wants
         for target in targets:

@@ -227,9 +227,6 @@ class Locator:
         return line, start - (self._source_text.rfind("\n", 0, start) + 1) + 1
 
 
-def _selected(code: str, rules: list[Rule]) -> bool:
-    return any(rule.code == code for rule in rules)
-
 
 def _file_ignored(shown: str, code: str, options: LintOptions) -> bool:
     for pattern, codes in options.per_file_ignores.items():

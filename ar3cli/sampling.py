@@ -91,13 +91,12 @@ def joint_space(body: Any) -> JointSpace:
     """The joint space of a loaded :class:`~ar3cli.sim.Body` (its ``model`` gives the mimic couplings)."""
     joints = body.movable_joints
     driving = tuple(i for i, joint in enumerate(joints) if not is_mimic(joint, body.model))
-    for i in driving:
-        lower, upper = joints[i].sample_range()
+    ranges = np.array([joints[i].sample_range() for i in driving], dtype=float).reshape(-1, 2)
+    for i, (lower, upper) in zip(driving, ranges):
         if not (np.isfinite(lower) and np.isfinite(upper)):
             where = f"{body.model.path}:{joints[i].urdf.line}" if joints[i].urdf is not None else str(body.model.path)
             raise UserError(f"{where}: joint '{joints[i].name}' has limits ({lower}, {upper}) that cannot be "
                             "sampled; give finite numbers (lint-urdf reports this as F007)")
-    ranges = np.array([joints[i].sample_range() for i in driving], dtype=float).reshape(-1, 2)
     partial = JointSpace(
         names=tuple(joint.name for joint in joints), driving=driving,
         lower=ranges[:, 0].copy(), upper=ranges[:, 1].copy(),

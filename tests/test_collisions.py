@@ -10,10 +10,11 @@ import pytest
 from lxml import etree
 
 from ar3cli import collision_matrix as cm
-from ar3cli.collisions import (CONTACT_TOLERANCE, Checker, ModelSource, count_collisions, limit_configurations,
-                               sample_configurations)
+from ar3cli.adjacency import adjacent_pairs
+from ar3cli.collisions import Checker, ModelSource, count_collisions
 from ar3cli.model import load_model
-from ar3cli.sim import Session
+from ar3cli.sampling import limit_configurations, sample_configurations
+from ar3cli.sim import PENETRATION_TOLERANCE, Session
 from tests.conftest import ASSETS
 
 ROBOTS = {
@@ -80,7 +81,7 @@ def test_counts_match_independent_brute_force(name, pybullet_data_dir):
     theirs = brute_force(model, configs)
     differing = 0
     for hits, distances in zip(ours, theirs):
-        expected = {pair for pair, distance in distances.items() if distance < -CONTACT_TOLERANCE}
+        expected = {pair for pair, distance in distances.items() if distance < -PENETRATION_TOLERANCE}
         for pair in hits ^ expected:
             assert abs(distances.get(pair, 1.0)) < BORDERLINE, (sorted(pair), distances.get(pair))
         differing += hits != expected
@@ -199,7 +200,7 @@ def test_classification_on_a_small_chain(cli, write_urdf):
     assert category[frozenset(("arm", "tip"))] == "adjacent"
     assert any(w["rule"] == "visual-only-links" and "hub" in w["message"] for w in doc["warnings"])
     model = load_model(path)
-    assert cm.adjacent_pairs(model, ["base", "arm", "tip"]) == {frozenset(("base", "arm")),
+    assert adjacent_pairs(model, ["base", "arm", "tip"]) == {frozenset(("base", "arm")),
                                                                   frozenset(("arm", "tip"))}
     with Checker(model) as checker:
         space = checker.joint_space()
