@@ -1,8 +1,9 @@
 """A small on-disk cache of facts about files that are slow to compute (mesh bounding boxes).
 
 A pre-commit hook or a CI step lints the same meshes again and again; reading 50 MB of OBJ and
-STL text takes longer than all the rules together. Facts are keyed by the file's absolute path,
-modification time (ns) and size, so an edited mesh is read again. The cache is one JSON file per
+STL text takes longer than all the rules together. Facts are keyed by the file's absolute path
+(not resolved through symlinks: realpath costs more than the lookup it serves), modification time
+(ns) and size, so an edited mesh is read again. The cache is one JSON file per
 kind of fact, written atomically at exit and only when something new was learnt; a corrupt or
 unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
 ``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
@@ -42,7 +43,7 @@ class FileFacts:
         self._dirty = False
 
     def _key(self, path: Path, stat: os.stat_result) -> str:
-        return f"{path.resolve()}|{stat.st_mtime_ns}|{stat.st_size}"
+        return f"{os.path.abspath(path)}|{stat.st_mtime_ns}|{stat.st_size}"
 
     def _file(self) -> Path | None:
         folder = cache_dir()

@@ -40,7 +40,7 @@ def parse_floats(text: str | None, count: int | None = None) -> tuple[float, ...
     if text is None:
         return None
     try:
-        values = tuple(float(part) for part in text.split())
+        values = tuple(map(float, text.split()))
     except ValueError:
         return None
     if count is not None and len(values) != count:
