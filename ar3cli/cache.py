@@ -34,11 +34,16 @@ def cache_dir() -> Path | None:
 
 
 class FileFacts:
-    """Facts (JSON values) about files, persisted in ``<cache dir>/<name>.json``."""
+    """Facts (JSON values) about files, persisted in ``<cache dir>/<name>-v<version>.json``.
 
-    def __init__(self, name: str, version: int) -> None:
+    Keys are built from a file's path and stat (:meth:`get` / :meth:`put`) or given whole by the
+    caller (:meth:`lookup` / :meth:`store`). At most ``max_entries`` are kept.
+    """
+
+    def __init__(self, name: str, version: int, max_entries: int = MAX_ENTRIES) -> None:
         self.name = name
         self.version = version
+        self.max_entries = max_entries
         self._entries: dict[str, Any] | None = None
         self._dirty = False
 
@@ -64,12 +69,19 @@ class FileFacts:
 
     def get(self, path: Path, stat: os.stat_result) -> Any:
         """The stored fact for this version of ``path``, or :data:`MISSING`."""
-        return self._load().get(self._key(path, stat), MISSING)
+        return self.lookup(self._key(path, stat))
 
     def put(self, path: Path, stat: os.stat_result, value: Any) -> None:
         """Remember ``value`` (JSON-serialisable) for this version of ``path``; saved at exit."""
-        entries = self._load()
-        entries[self._key(path, stat)] = value
+        self.store(self._key(path, stat), value)
+
+    def lookup(self, key: str) -> Any:
+        """The value stored under ``key``, or :data:`MISSING`."""
+        return self._load().get(key, MISSING)
+
+    def store(self, key: str, value: Any) -> None:
+        """Remember ``value`` (JSON-serialisable) under ``key``; saved at exit."""
+        self._load()[key] = value
         if not self._dirty and self._file() is not None:
             atexit.register(self.save)
         self._dirty = True
@@ -80,7 +92,7 @@ class FileFacts:
         if not self._dirty or location is None or self._entries is None:
             return
         entries = self._entries
-        if len(entries) > MAX_ENTRIES:
+        if len(entries) > self.max_entries:
             entries = dict(list(entries.items())[len(entries) // 2:])
         try:
             from ar3cli.atomic import atomic_write

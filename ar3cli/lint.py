@@ -119,17 +119,45 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
     return list(unique.values())
 
 
-def lint_paths(paths: Iterable[Path], options: LintOptions) -> list[FileResult]:
-    """Lint every file under ``paths``; one :class:`FileResult` per file, in order."""
+def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = True) -> list[FileResult]:
+    """Lint every file under ``paths``; one :class:`FileResult` per file, in order.
+
+    With ``use_cache``, unchanged files reuse the findings of an earlier run (:mod:`ar3cli.lint_cache`).
+    """
     rules = options.rules()
-    return [lint_file(path, rules, options) for path in collect_files(paths)]
+    cache = _result_cache(options, rules) if use_cache else None
+    return [lint_file(path, rules, options, cache) for path in collect_files(paths)]
 
 
-def lint_file(path: Path, rules: list[Rule], options: LintOptions) -> FileResult:
-    """Load one file and run ``rules`` on it; a load failure is a finding, never an exception."""
+def _result_cache(options: LintOptions, rules: list[Rule]):
+    """The result cache for these settings, or None when caching is off or cannot apply (``--sim``)."""
+    from ar3cli.cache import cache_dir
+
+    if options.sim or cache_dir() is None:
+        return None
+    from ar3cli.lint_cache import ResultCache
+
+    settings = repr(([rule.code for rule in rules], sorted(options.per_file_ignores.items()),
+                     sorted((code, level.value) for code, level in options.severity.items()),
+                     sorted((name, os.path.abspath(folder)) for name, folder in options.package_paths.items()),
+                     sorted(options.xacro_args.items())))
+    return ResultCache(settings)
+
+
+def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache=None) -> FileResult:
+    """Load one file and run ``rules`` on it; a load failure is a finding, never an exception.
+
+    ``cache`` (a :class:`~ar3cli.lint_cache.ResultCache`) answers for unchanged ``.urdf`` files
+    and learns the findings of the others.
+    """
     from ar3cli.model import load_model
+    from ar3cli.xacro_expand import is_xacro
 
     shown = display_path(path)
+    if cache is not None and not is_xacro(path):
+        remembered = cache.get(path, shown)
+        if remembered is not None:
+            return FileResult(shown, True, remembered)
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
@@ -137,7 +165,10 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions) -> FileResult
     except RecursionError:
         finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
     else:
-        return _lint_model(model, shown, rules, options)
+        result = _lint_model(model, shown, rules, options)
+        if cache is not None and not model.is_xacro:
+            cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
+        return result
     # A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
     # always reports syntax errors); only an explicit ignore hides it.
     if matches(finding.rule, options.ignore) or _file_ignored(shown, finding.rule, options):

@@ -92,6 +92,17 @@ class PackageResolver:
         self._ros_paths = [Path(p) for p in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
         self._ament_prefixes = [Path(p) for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
         self._packages: dict[str, tuple[Path | None, tuple[str, ...]]] = {}
+        self.probed: set[str] = set()
+        """Every path whose existence or content a resolution depended on (for the lint result cache)."""
+
+    def _probe(self, path: Path) -> Path:
+        """``path``, remembered in :attr:`probed` (call it on every path before looking at the disk)."""
+        self.probed.add(str(path))
+        return path
+
+    def _package_name(self, folder: Path) -> str | None:
+        self._probe(folder / "package.xml")
+        return _package_xml_name(folder)
 
     def find_package(self, name: str) -> tuple[Path | None, tuple[str, ...]]:
         """Folder of package ``name`` and the candidates tried, following the module's order."""
@@ -104,23 +115,23 @@ class PackageResolver:
 
         def accept(candidate: Path) -> bool:
             tried.append(str(candidate))
-            return candidate.is_dir()
+            return self._probe(candidate).is_dir()
 
         if name in self.package_paths and accept(self.package_paths[name]):
             return self.package_paths[name], tuple(tried)
         for entry in self._ros_paths:
             if accept(entry / name):
                 return entry / name, tuple(tried)
-            if entry.name == name or _package_xml_name(entry) == name:
+            if entry.name == name or self._package_name(entry) == name:
                 return entry, tuple(tried)
         for prefix in self._ament_prefixes:
             if accept(prefix / "share" / name):
                 return prefix / "share" / name, tuple(tried)
         for ancestor in [self.base_dir, *self.base_dir.parents]:
-            if ancestor.name == name or _package_xml_name(ancestor) == name:
+            if ancestor.name == name or self._package_name(ancestor) == name:
                 return ancestor, tuple(tried)
-            sibling = ancestor / name
-            if sibling.is_dir() and _package_xml_name(sibling) in (name, None) and (sibling / "package.xml").exists():
+            sibling = self._probe(ancestor / name)
+            if sibling.is_dir() and self._package_name(sibling) in (name, None) and (sibling / "package.xml").exists():
                 return sibling, tuple(tried)
         tried.append(f"ancestors of {self.base_dir} named {name} or with package.xml <name>{name}</name>")
         return None, tuple(tried)
@@ -136,7 +147,7 @@ class PackageResolver:
             if folder is not None:
                 candidate = folder / unquote(rest)
                 tried = (*tried, str(candidate))
-                if candidate.is_file():
+                if self._probe(candidate).is_file():
                     return Resolution(uri, candidate, tried, via="package")
             return self._pybullet_search(uri, unquote(uri[len("package://"):]), tried,
                                          f"package '{name}' not found" if folder is None else "file not found in package")
@@ -148,7 +159,7 @@ class PackageResolver:
             candidate = Path(uri)
         if not candidate.is_absolute():
             candidate = self.base_dir / candidate
-        if candidate.is_file():
+        if self._probe(candidate).is_file():
             return Resolution(uri, candidate, (str(candidate),), via="direct")
         if Path(uri).is_absolute() or uri.startswith("file://"):
             return Resolution(uri, None, (str(candidate),), "file not found")
@@ -161,6 +172,6 @@ class PackageResolver:
             candidate = folder / relative
             if str(candidate) not in tried:
                 tried = (*tried, str(candidate))
-            if candidate.is_file():
+            if self._probe(candidate).is_file():
                 return Resolution(uri, candidate, tried, via="pybullet-search")
         return Resolution(uri, None, tried, problem)

@@ -51,6 +51,9 @@ def lint_urdf(
     = False,
     no_config: Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
     = False,
+    no_cache: Annotated[bool, typer.Option("--no-cache", help="Check every file again instead of reusing the "
+                                                              "findings of unchanged files from earlier runs "
+                                                              "(also AR3CLI_NO_CACHE=1).")] = False,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
 ) -> None:
@@ -76,7 +79,7 @@ def lint_urdf(
     except ValueError as exc:
         raise UserError(str(exc)) from None
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
-    results = lint_paths(paths, options)
+    results = lint_paths(paths, options, use_cache=not no_cache)
     if not results:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     summary = summarize(results, threshold)

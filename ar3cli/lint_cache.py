@@ -1,0 +1,128 @@
+"""Lint results remembered between runs: a file that has not changed is not checked again.
+
+A pre-commit hook with ``--all-files``, a CI job with a cached home folder, or an editor linting on
+save checks the same unchanged models again and again. Like ruff, ar3cli keeps each file's findings
+and reuses them while nothing they depend on has changed:
+
+* the file's bytes, its path (as given and absolute), the selected rules and every option, the
+  ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH`` environment, and ar3cli itself (version and the
+  size and time of each of its source files), all hashed into the key;
+* every path the package resolver looked at (meshes found or missing, ``package.xml`` files,
+  package folders), with its size, time and type, or its absence: checked again on every hit,
+  so a mesh that is edited, appears or disappears, or a ``package.xml`` that now names a package,
+  makes the result stale. The rules read no other file than these and the model itself.
+
+Only static lints of ``.urdf`` files that loaded are remembered: xacro expansion reads includes
+that ar3cli does not see, and ``--sim`` results depend on PyBullet. ``--no-cache`` or
+``AR3CLI_NO_CACHE=1`` turn it off; the store is ``<cache dir>/lint-results-v1.json``
+(:mod:`ar3cli.cache`).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import os
+import stat
+import sys
+from collections.abc import Iterable
+from pathlib import Path
+
+from ar3cli import __version__
+from ar3cli.cache import MISSING, FileFacts
+from ar3cli.findings import Finding, Severity
+
+MAX_RESULTS = 1_000
+"""Remembered files; beyond this the oldest half is dropped. Every run reads the whole store
+(about 2.5 kB a file: 1000 files take ~10 ms to load)."""
+
+_STORE = FileFacts("lint-results", version=1, max_entries=MAX_RESULTS)
+_PACKAGE_DIR = Path(__file__).resolve().parent
+_ENVIRONMENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH")
+
+Signature = list[int] | None
+"""A path's state: [modification time (ns), size, file type], or None when it does not exist."""
+
+
+def signature(path: str) -> Signature:
+    """The state of ``path`` now (symlinks followed)."""
+    try:
+        status = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return [status.st_mtime_ns, status.st_size, stat.S_IFMT(status.st_mode)]
+
+
+def code_fingerprint() -> str:
+    """ar3cli's version plus the size and time of each of its source files: an edited rule (or
+    a reinstall) makes every remembered result stale. (``os.scandir``: ``os.walk`` costs 10 ms.)"""
+    parts = []
+    folders = [str(_PACKAGE_DIR)]
+    while folders:
+        with os.scandir(folders.pop()) as entries:
+            for entry in entries:
+                if entry.name.endswith(".py"):
+                    status = entry.stat()
+                    parts.append(f"{entry.path}:{status.st_mtime_ns}:{status.st_size}")
+                elif entry.name not in ("__pycache__", "assets") and entry.is_dir():
+                    folders.append(entry.path)
+    return "\n".join([__version__, sys.version, _lxml_version(), *sorted(parts)])
+
+
+def _lxml_version() -> str:
+    """lxml's version without importing lxml.etree (a fully cached run never parses XML)."""
+    import lxml
+
+    return str(getattr(lxml, "__version__", ""))
+
+
+class ResultCache:
+    """Remembered findings for one lint run's settings (rules, options, environment)."""
+
+    def __init__(self, settings: str) -> None:
+        """``settings``: everything about the run that can change a file's findings, as text."""
+        context = [code_fingerprint(), settings, *(f"{name}={os.environ.get(name, '')}" for name in _ENVIRONMENT)]
+        self._context = hashlib.sha256("\n".join(context).encode("utf-8", "surrogateescape")).digest()
+
+    def _key(self, path: Path, shown: str, content: bytes) -> str:
+        digest = hashlib.sha256(self._context)
+        for part in (os.path.abspath(path), shown):
+            digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
+        digest.update(content)
+        return digest.hexdigest()
+
+    def get(self, path: Path, shown: str) -> list[Finding] | None:
+        """The findings remembered for this file, or None when it must be checked."""
+        content = _read(path)
+        if content is None:
+            return None
+        entry = _STORE.lookup(self._key(path, shown, content))
+        if entry is MISSING or not isinstance(entry, dict):
+            return None
+        try:
+            depends = entry["depends"]
+            if any(signature(dependency) != state for dependency, state in depends.items()):
+                return None
+            findings = [Finding(rule, Severity(severity), message, shown, line, column, hint)
+                        for rule, severity, message, line, column, hint in entry["findings"]]
+        except (KeyError, TypeError, ValueError, AttributeError):  # a damaged entry: check the file again
+            return None
+        return findings
+
+    def put(self, path: Path, shown: str, content: bytes, findings: list[Finding], probed: Iterable[str]) -> None:
+        """Remember the findings of ``path`` as it was when read (``content``) and the state of every
+        path they depended on: one that appears, disappears or changes makes them stale."""
+        _STORE.store(self._key(path, shown, content), {
+            "depends": {dependency: signature(dependency) for dependency in probed},
+            "findings": [[f.rule, f.severity.value, f.message, f.line, f.column, f.hint] for f in findings],
+        })
+
+
+def _read(path: Path) -> bytes | None:
+    """The file's bytes as the loader would read them (same size limit), or None."""
+    from ar3cli.errors import UserError
+    from ar3cli.xmlsource import read_bytes
+
+    try:
+        return read_bytes(path)
+    except UserError:
+        return None
