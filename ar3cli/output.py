@@ -191,6 +191,12 @@ def render(report: Report, fmt: OutputFormat | str) -> None:
     if report.text:
         sys.stdout.write(report.text)
         sys.stdout.flush()
+    stream = sys.stderr if report.text else sys.stdout
+    if not report.renderables and not stream.isatty():
+        # Pipes, CI logs, pre-commit: plain tables and lines need no rich (importing it costs ~25 ms).
+        stream.write("".join([*map(plain_table, report.tables), *(line + "\n" for line in report.lines)]))
+        stream.flush()
+        return
     out = console(stderr=bool(report.text))
     for table in report.tables:
         render_table(table, out)
