@@ -4,9 +4,10 @@ A pre-commit hook with ``--all-files``, a CI job with a cached home folder, or a
 save checks the same unchanged models again and again. Like ruff, ar3cli keeps each file's findings
 and reuses them while nothing they depend on has changed:
 
-* the file's bytes, its path (as given and absolute), the selected rules and every option, the
+* the file's path (as given and absolute), the selected rules and every option, the
   ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH`` environment, and ar3cli itself (version and the
-  size and time of each of its source files), all hashed into the key;
+  size and time of each of its source files), all hashed into the key: one entry per file;
+* the file's bytes (a hash of them, checked on every hit);
 * every path the package resolver looked at (meshes found or missing, ``package.xml`` files,
   package folders), with its size, time and type, or its absence: checked again on every hit,
   so a mesh that is edited, appears or disappears, or a ``package.xml`` that now names a package,
@@ -28,7 +29,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from ar3cli import __version__
-from ar3cli.cache import MISSING, FileFacts
+from ar3cli.cache import FileFacts
 from ar3cli.findings import Finding, Severity
 
 MAX_RESULTS = 1_000
@@ -83,11 +84,11 @@ class ResultCache:
         context = [code_fingerprint(), settings, *(f"{name}={os.environ.get(name, '')}" for name in _ENVIRONMENT)]
         self._context = hashlib.sha256("\n".join(context).encode("utf-8", "surrogateescape")).digest()
 
-    def _key(self, path: Path, shown: str, content: bytes) -> str:
+    def _key(self, path: Path, shown: str) -> str:
+        """One entry per file and settings: a new version of a file replaces the old one."""
         digest = hashlib.sha256(self._context)
         for part in (os.path.abspath(path), shown):
             digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
-        digest.update(content)
         return digest.hexdigest()
 
     def get(self, path: Path, shown: str) -> list[Finding] | None:
@@ -95,23 +96,22 @@ class ResultCache:
         content = _read(path)
         if content is None:
             return None
-        entry = _STORE.lookup(self._key(path, shown, content))
-        if entry is MISSING or not isinstance(entry, dict):
-            return None
+        entry = _STORE.lookup(self._key(path, shown))
         try:
-            depends = entry["depends"]
-            if any(signature(dependency) != state for dependency, state in depends.items()):
+            if entry["content"] != hashlib.sha256(content).hexdigest():
                 return None
-            findings = [Finding(rule, Severity(severity), message, shown, line, column, hint)
-                        for rule, severity, message, line, column, hint in entry["findings"]]
-        except (KeyError, TypeError, ValueError, AttributeError):  # a damaged entry: check the file again
+            if any(signature(dependency) != state for dependency, state in entry["depends"].items()):
+                return None
+            return [Finding(rule, Severity(severity), message, shown, line, column, hint)
+                    for rule, severity, message, line, column, hint in entry["findings"]]
+        except (KeyError, TypeError, ValueError, AttributeError):  # none, or damaged: check the file
             return None
-        return findings
 
     def put(self, path: Path, shown: str, content: bytes, findings: list[Finding], probed: Iterable[str]) -> None:
         """Remember the findings of ``path`` as it was when read (``content``) and the state of every
         path they depended on: one that appears, disappears or changes makes them stale."""
-        _STORE.store(self._key(path, shown, content), {
+        _STORE.store(self._key(path, shown), {
+            "content": hashlib.sha256(content).hexdigest(),
             "depends": {dependency: signature(dependency) for dependency in probed},
             "findings": [[f.rule, f.severity.value, f.message, f.line, f.column, f.hint] for f in findings],
         })

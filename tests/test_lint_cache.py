@@ -70,12 +70,13 @@ def test_an_unchanged_file_is_answered_from_the_cache(store, loads, write_urdf) 
     assert second == first and "G001" in {f["rule"] for f in first}
 
 
-def test_an_edited_file_is_checked_again(store, loads, write_urdf) -> None:
+def test_an_edited_file_is_checked_again_and_replaces_its_entry(store, loads, write_urdf) -> None:
     path = write_urdf(MESH_ROBOT.format(uri="meshes/missing.stl"))
     assert "G001" in codes(path)
     write_urdf(MESH_ROBOT.format(uri="meshes/missing.stl").replace('name="r"', ""))
     assert {"G001", "S001"} <= codes(path)
     assert len(loads) == 2
+    assert len(lint_cache._STORE._load()) == 1  # a file edited a thousand times keeps one entry
 
 
 def test_a_mesh_that_appears_or_disappears_is_noticed(store, loads, write_urdf, tmp_path) -> None:
@@ -133,8 +134,8 @@ def test_a_damaged_store_or_entry_means_checking_again(store, loads, write_urdf)
     store.mkdir()
     (store / "lint-results-v1.json").write_bytes(b"\x00not json")
     expected = findings(path)
-    for key in list(lint_cache._STORE._load()):
-        lint_cache._STORE.store(key, {"depends": {}, "findings": [["G001", "fatal"]]})
+    (entry,) = lint_cache._STORE._load().values()
+    entry["findings"] = [["G001", "fatal"]]
     assert findings(path) == expected
     assert len(loads) == 2
 
