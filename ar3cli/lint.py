@@ -93,9 +93,10 @@ class Context:
 def display_path(path: Path) -> str:
     """The path relative to the current directory when it is below it, else as given."""
     try:
-        return Path(os.path.relpath(path)).as_posix() if not os.path.relpath(path).startswith("..") else str(path)
+        relative = os.path.relpath(path)
     except ValueError:  # another drive on Windows
         return str(path)
+    return str(path) if relative.startswith("..") else Path(relative).as_posix()
 
 
 def collect_files(paths: Iterable[Path]) -> list[Path]:
@@ -209,7 +210,8 @@ def load_failure(path: Path, shown: str, message: str) -> Finding:
             line = int(match.group(1) or 0)
             message = message[match.end():]
             break
-    if any(key in message for key in ("no such file", "is a directory", "cannot read", "MB limit")):
+    if any(key in message for key in ("no such file", "is a directory", "not a regular file", "cannot read",
+                                      "MB limit")):
         code = "F001"
     elif "xacro error" in message or "$(find" in message:
         code = "F004"

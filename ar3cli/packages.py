@@ -67,6 +67,8 @@ def parse_package_paths(items: list[str] | None) -> dict[str, Path]:
 def _package_xml_name(folder: Path) -> str | None:
     manifest = folder / "package.xml"
     try:
+        if not manifest.is_file():  # missing, or a pipe that would never end
+            return None
         match = _PACKAGE_NAME.search(manifest.read_bytes()[:65536])
     except OSError:
         return None

@@ -14,6 +14,7 @@ so any ``<!ENTITY`` is refused before parsing. DTDs are not loaded and the netwo
 from __future__ import annotations
 
 import re
+import stat
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -48,7 +49,10 @@ def read_bytes(path: Path) -> bytes:
         raise UserError(f"{path}: no such file")
     if path.is_dir():
         raise UserError(f"{path}: is a directory, expected a .urdf or .xacro file")
-    size = path.stat().st_size
+    status = path.stat()
+    if not stat.S_ISREG(status.st_mode):  # reading a FIFO or a terminal would wait forever
+        raise UserError(f"{path}: not a regular file (a pipe, socket or device); expected a .urdf or .xacro file")
+    size = status.st_size
     if size > MAX_FILE_BYTES:
         raise UserError(
             f"{path}: file is {size / 1e6:.0f} MB, larger than the {MAX_FILE_BYTES // 1024 // 1024} MB limit "

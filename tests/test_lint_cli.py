@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -185,6 +186,18 @@ def test_bad_input_is_a_finding_and_the_run_goes_on(cli, tmp_path, name, content
     assert finding["rule"] == code
     assert "root:" not in result.stdout and "/bin/" not in result.stdout  # nothing of /etc/passwd leaked
     assert len(doc["files"]) == 2
+
+
+@pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="named pipes are a POSIX feature")
+def test_a_named_pipe_is_a_finding_not_a_hang(cli, tmp_path):
+    """Reading a FIFO waits for a writer forever: it is refused as not a regular file."""
+    os.mkfifo(tmp_path / "pipe.urdf")
+    (tmp_path / "zgood.urdf").write_text(arm())
+    result = cli("lint-urdf", str(tmp_path), "--format", "json", timeout=60)
+    (finding,) = json.loads(result.stdout)["findings"]
+    assert result.code == 1 and finding["rule"] == "F001" and "not a regular file" in finding["message"]
+    fixer = cli("fix-inertia", "--check", str(tmp_path / "pipe.urdf"), timeout=60)
+    assert fixer.code == 2 and fixer.stderr.count("\n") == 1 and "not a regular file" in fixer.stderr
 
 
 def test_directory_named_like_a_file_and_missing_paths(cli, tmp_path):

@@ -10,7 +10,8 @@ from ar3cli.rules.base import Hit, engine_rule, robot, rule
 
 unreadable = engine_rule(
     "F001", "unreadable", "error", "File cannot be read",
-    why="The path is missing, a directory, too large, or not readable; nothing else can be checked.",
+    why="The path is missing, a directory, a pipe or device, too large, or not readable; nothing else can "
+        "be checked.",
     fix="Check the path and its permissions.",
     bad="(a path that does not exist)", good=robot('<link name="base"/>'))
 
