@@ -97,15 +97,17 @@ def main() -> None:
     python = median([sys.executable, "-c", "pass"], args.repeats)
     libraries = median([sys.executable, "-c", "import typer, rich, lxml.etree"], args.repeats)
     first = median([*lint, str(panda)], args.repeats, empty_cache=True)
+    checked = median([*lint, "--no-cache", str(panda)], args.repeats)
     one = median([*lint, str(panda)], args.repeats)
     print(f"\npanda.urdf, cold process (median of {args.repeats}):")
-    print(f"  python -c pass                        {python}")
-    print(f"  python -c 'import typer, rich, lxml'  {libraries}")
-    print(f"  ar3cli lint-urdf, empty mesh cache    {first}")
-    print(f"  ar3cli lint-urdf                      {one}   = {one.wall / libraries.wall:.1f}x the imports; "
-          f"target <= 0.3 s wall: {'met' if one.wall <= 0.3 else 'NOT met'}")
+    print(f"  python -c pass                                {python}")
+    print(f"  python -c 'import typer, rich, lxml'          {libraries}")
+    print(f"  ar3cli lint-urdf, nothing cached              {first}")
+    print(f"  ar3cli lint-urdf, --no-cache (meshes cached)  {checked}   target <= 0.3 s wall: "
+          f"{'met' if checked.wall <= 0.3 else 'NOT met'}")
+    print(f"  ar3cli lint-urdf, result cached               {one}")
     if check_urdf:
-        print(f"  check_urdf                            {median([check_urdf, str(panda)], args.repeats)}")
+        print(f"  check_urdf                                    {median([check_urdf, str(panda)], args.repeats)}")
 
     paths = list(map(str, models))
     variants = {
