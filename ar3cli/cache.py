@@ -7,6 +7,9 @@ STL text takes longer than all the rules together. Facts are keyed by the file's
 kind of fact, written atomically at exit and only when something new was learnt; a corrupt or
 unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
 ``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
+
+A forked worker process (:mod:`ar3cli.process_pool`) never saves: it hands what it learnt to its
+parent (:func:`take_learned`), which merges it (:func:`merge_learned`) and saves once.
 """
 
 from __future__ import annotations
@@ -21,6 +24,9 @@ MAX_ENTRIES = 20_000
 """Beyond this many entries the oldest half is dropped when saving (the cache stays small)."""
 
 MISSING = object()
+
+_OPEN: dict[str, FileFacts] = {}
+"""This process's caches by name, for handing what a worker learnt to its parent."""
 
 
 def cache_dir() -> Path | None:
@@ -46,6 +52,8 @@ class FileFacts:
         self.max_entries = max_entries
         self._entries: dict[str, Any] | None = None
         self._dirty = False
+        self._learned: dict[str, Any] = {}
+        _OPEN[name] = self
 
     def _key(self, path: Path, stat: os.stat_result) -> str:
         return f"{os.path.abspath(path)}|{stat.st_mtime_ns}|{stat.st_size}"
@@ -81,7 +89,11 @@ class FileFacts:
 
     def store(self, key: str, value: Any) -> None:
         """Remember ``value`` (JSON-serialisable) under ``key``; saved at exit."""
-        self._load()[key] = value
+        self._learned[key] = value
+        self._merge({key: value})
+
+    def _merge(self, entries: dict[str, Any]) -> None:
+        self._load().update(entries)
         if not self._dirty and self._file() is not None:
             atexit.register(self.save)
         self._dirty = True
@@ -102,3 +114,18 @@ class FileFacts:
             self._dirty = False
         except Exception:  # noqa: BLE001 - a read-only home must never break a lint
             pass
+
+
+def take_learned() -> dict[str, dict[str, Any]]:
+    """What this process's caches learnt since the last call, by cache name (a worker's gift to its parent)."""
+    learned = {name: facts._learned for name, facts in _OPEN.items() if facts._learned}
+    for facts in _OPEN.values():
+        facts._learned = {}
+    return learned
+
+
+def merge_learned(learned: dict[str, dict[str, Any]]) -> None:
+    """Add what a worker learnt (:func:`take_learned`) to this process's caches, saved at exit."""
+    for name, entries in learned.items():
+        if name in _OPEN and entries:
+            _OPEN[name]._merge(entries)

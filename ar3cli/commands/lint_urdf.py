@@ -51,6 +51,11 @@ def lint_urdf(
     = False,
     no_config: Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
     = False,
+    jobs: Annotated[Optional[int], typer.Option("--jobs", "-j", min=1, show_default=False,
+                                                help="Processes that share the files. Default on Linux: one "
+                                                     "per CPU (at most 8) for 24+ files, or 2+ with --sim; "
+                                                     "1 elsewhere. The output is the same for any value.")]
+    = None,
     no_cache: Annotated[bool, typer.Option("--no-cache", help="Check every file again instead of reusing the "
                                                               "findings of unchanged files from earlier runs "
                                                               "(also AR3CLI_NO_CACHE=1).")] = False,
@@ -79,7 +84,7 @@ def lint_urdf(
     except ValueError as exc:
         raise UserError(str(exc)) from None
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
-    results = lint_paths(paths, options, use_cache=not no_cache)
+    results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs)
     if not results:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     summary = summarize(results, threshold)
