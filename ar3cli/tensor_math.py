@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from fractions import Fraction
 
 __all__ = ["is_positive_definite", "rpy_to_matrix", "satisfies_triangle_inequality", "symmetric_eigenvalues"]
 
@@ -78,6 +77,8 @@ def _refine_near_singular(entries: tuple[float, ...], values: list[float]) -> tu
     """Sorted eigenvalues, the smallest in magnitude recomputed when it is tiny (see above)."""
     small, middle, large = sorted(values, key=abs)
     if abs(small) < NEAR_SINGULAR * abs(large) and abs(middle) >= NEAR_SINGULAR * abs(large):
+        from fractions import Fraction  # rare: importing it costs ~2 ms of every lint's start-up
+
         a11, a22, a33, a12, a13, a23 = map(Fraction, entries)
         det = a11 * (a22 * a33 - a23 * a23) - a12 * (a12 * a33 - a23 * a13) + a13 * (a12 * a23 - a22 * a13)
         small = float(det / (Fraction(middle) * Fraction(large)))
