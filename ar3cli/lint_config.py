@@ -24,11 +24,6 @@ from typing import Any
 from ar3cli.errors import UserError
 from ar3cli.findings import Severity
 
-try:
-    import tomllib
-except ModuleNotFoundError:  # Python 3.10
-    tomllib = None  # type: ignore[assignment]
-
 KNOWN_KEYS = {"select", "ignore", "per-file-ignores", "severity", "fail-on"}
 
 
@@ -61,12 +56,20 @@ def load_config(start: Path | None = None) -> LintConfig:
     path = find_pyproject((start or Path.cwd()).resolve())
     if path is None:
         return LintConfig()
-    if tomllib is None:
+    try:
+        text = path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise UserError(f"{path}: cannot read configuration: {exc}") from None
+    if "ar3cli" not in text:  # another tool's pyproject: no need to parse it (or import tomllib)
+        return LintConfig(path)
+    try:
+        import tomllib
+    except ModuleNotFoundError:  # Python 3.10
         log(f"ar3cli: warning: {path}: Python 3.10 has no tomllib; [tool.ar3cli.lint] is ignored")
         return LintConfig(path)
     try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError) as exc:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
         raise UserError(f"{path}: cannot read configuration: {exc}") from None
     table: dict[str, Any] = data.get("tool", {}).get("ar3cli", {}).get("lint", {})
     if not isinstance(table, dict):

@@ -12,7 +12,6 @@ safe there) everything runs in this process.
 from __future__ import annotations
 
 import os
-import pickle
 import signal
 import sys
 from collections.abc import Callable, Sequence
@@ -79,6 +78,8 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
 
 def _start_child(function: Callable[[Item], Result], share: Sequence[Item]) -> tuple[int, int]:
     """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe."""
+    import pickle
+
     read_end, write_end = os.pipe()
     pid = os.fork()
     if pid == 0:  # the child: never returns
@@ -108,6 +109,8 @@ def _read_and_reap(pid: int, pipe: int) -> bytes:
 
 def _unpack(data: bytes, what: str) -> list:
     """The child's results; its failure is raised here as it would have been in this process."""
+    import pickle
+
     try:
         status, payload = pickle.loads(data)
     except Exception:  # noqa: BLE001 - an empty or cut answer: the child died

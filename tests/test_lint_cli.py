@@ -121,6 +121,11 @@ def test_pyproject_configuration(cli, tmp_path):
     (tmp_path / "pyproject.toml").write_text('[tool.ar3cli.lint]\nselekt = ["J"]\n')
     typo = cli("lint-urdf", "models", cwd=tmp_path)
     assert typo.code == 2 and "unknown key" in typo.stderr
+    (tmp_path / "pyproject.toml").write_text('[tool.ar3cli.lint\nignore = ["G"]\n')
+    broken = cli("lint-urdf", "models", cwd=tmp_path)
+    assert broken.code == 2 and "cannot read configuration" in broken.stderr and broken.stderr.count("\n") == 1
+    (tmp_path / "pyproject.toml").write_text('[tool.black\nline-length = 100\n')  # not ours, even if broken
+    assert cli("lint-urdf", "models", cwd=tmp_path).code == 1
 
 
 def test_inline_and_file_level_suppression(cli, write_urdf):
