@@ -94,6 +94,7 @@ class PackageResolver:
         self._ros_paths = [Path(p) for p in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
         self._ament_prefixes = [Path(p) for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
         self._packages: dict[str, tuple[Path | None, tuple[str, ...]]] = {}
+        self._resolutions: dict[str, Resolution] = {}
         self.probed: set[str] = set()
         """Every path whose existence or content a resolution depended on (for the lint result cache)."""
 
@@ -139,7 +140,13 @@ class PackageResolver:
         return None, tuple(tried)
 
     def resolve(self, uri: str) -> Resolution:
-        """Resolve one URI as found in a ``filename`` attribute."""
+        """Resolve one URI as found in a ``filename`` attribute (once per resolver: a visual and
+        its collision usually share their mesh)."""
+        if uri not in self._resolutions:
+            self._resolutions[uri] = self._resolve(uri)
+        return self._resolutions[uri]
+
+    def _resolve(self, uri: str) -> Resolution:
         uri = uri.strip()
         if uri.startswith("package://"):
             name, _, rest = uri[len("package://"):].partition("/")

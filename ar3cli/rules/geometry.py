@@ -80,7 +80,7 @@ def link_bounds(link) -> Box | None:
     F007 reports the number; a box built from it would mean nothing).
     """
     boxes = [b for b in (shape_bounds(s) for s in (link.collisions or link.visuals)) if b is not None]
-    if not boxes or not all(math.isfinite(v) for box in boxes for corner in box for v in corner):
+    if not boxes or not all(all(map(math.isfinite, corner)) for box in boxes for corner in box):
         return None
     lows, highs = zip(*boxes)
     return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]

@@ -28,7 +28,7 @@ def tensor_moments(tensor: tuple[float, ...]) -> tuple[float, float, float]:
 
 
 def finite_tensor(tensor) -> bool:
-    return tensor is not None and all(math.isfinite(v) for v in tensor)
+    return tensor is not None and all(map(math.isfinite, tensor))
 
 
 def _fmt(moments) -> str:
