@@ -1,7 +1,7 @@
 """Lint results remembered between runs: a file that has not changed is not checked again.
 
-A pre-commit hook with ``--all-files``, a CI job with a cached home folder, or an editor linting on
-save checks the same unchanged models again and again. Like ruff, ar3cli keeps each file's findings
+``pre-commit run --all-files``, a developer re-running a lint, or an editor linting on save
+checks the same unchanged models again and again. Like ruff, ar3cli keeps each file's findings
 and reuses them while nothing they depend on has changed:
 
 * the file's path (as given and absolute), the selected rules and every option, the
