@@ -5,8 +5,6 @@ Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad inp
 ``AR3CLI_DEBUG=1`` to see the traceback).
 """
 
-from __future__ import annotations
-
 import os
 import sys
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cached_property, lru_cache
 from pathlib import Path
 from typing import Any
 
@@ -32,10 +32,12 @@ URDF_JOINT_TYPES = (*ACTUATED_JOINT_TYPES, "fixed", "floating", "planar")
 """The joint types of the URDF spec."""
 
 
+@lru_cache(maxsize=4096)
 def parse_floats(text: str | None, count: int | None = None) -> tuple[float, ...] | None:
     """Parse whitespace-separated numbers; ``None`` when missing, non-numeric or the wrong count.
 
-    NaN and inf parse (they are numbers to Python) and are left for the linter to flag.
+    NaN and inf parse (they are numbers to Python) and are left for the linter to flag. Cached:
+    robot files repeat the same few texts ("0 0 0", "1 0 0") thousands of times.
     """
     if text is None:
         return None
@@ -232,11 +234,13 @@ class Model:
         return [j for j in self.joints if j.moves]
 
     def meshes(self) -> Iterator[tuple[Link, Shape]]:
-        """Every (link, shape) whose geometry is a mesh."""
-        for link in self.links:
-            for shape in (*link.visuals, *link.collisions):
-                if shape.geometry.kind == "mesh":
-                    yield link, shape
+        """Every (link, shape) whose geometry is a mesh (listed once per model: nine rules ask)."""
+        return iter(self._mesh_shapes)
+
+    @cached_property
+    def _mesh_shapes(self) -> list[tuple[Link, Shape]]:
+        return [(link, shape) for link in self.links for shape in (*link.visuals, *link.collisions)
+                if shape.geometry.kind == "mesh"]
 
     # ---- text positions ----------------------------------------------------------------------
     @cached_property

@@ -1,7 +1,5 @@
 """``ar3cli fix-continuous``: remove fake limits from continuous joints, or give them real ones."""
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import Annotated, Optional
 

@@ -1,7 +1,5 @@
 """``ar3cli fix-inertia``: recompute bad ``<inertial>`` elements from the link geometry."""
 
-from __future__ import annotations
-
 import math
 from typing import Annotated, Optional
 

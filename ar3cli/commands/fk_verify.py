@@ -1,7 +1,5 @@
 """``ar3cli fk-verify``: PyBullet's link frames, and optionally a DH table, against the URDF."""
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import Annotated, Any, Optional
 

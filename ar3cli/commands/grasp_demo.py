@@ -1,7 +1,5 @@
 """``ar3cli grasp-demo``: the AR3 picks up a cube, in one command, headless by default."""
 
-from __future__ import annotations
-
 import os
 import sys
 from pathlib import Path

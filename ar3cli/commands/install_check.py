@@ -1,7 +1,5 @@
 """``ar3cli install-check``: the environment doctor."""
 
-from __future__ import annotations
-
 
 from ar3cli.options import FormatOption
 from ar3cli.output import OutputFormat, Report, Table, finish

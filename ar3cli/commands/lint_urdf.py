@@ -1,7 +1,5 @@
 """``ar3cli lint-urdf``: static (and optionally simulated) checks of URDF / xacro files."""
 
-from __future__ import annotations
-
 import enum
 import os
 from pathlib import Path

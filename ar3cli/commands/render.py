@@ -1,7 +1,5 @@
 """``ar3cli render``: a picture of the model, offscreen."""
 
-from __future__ import annotations
-
 from pathlib import Path
 from typing import Annotated, Optional
 

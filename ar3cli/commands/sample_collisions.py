@@ -1,7 +1,5 @@
 """``ar3cli sample-collisions``: the self-collision matrix, MoveIt-style, with statistics."""
 
-from __future__ import annotations
-
 import time
 from pathlib import Path
 from typing import Annotated, Optional

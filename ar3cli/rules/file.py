@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterator
+from functools import lru_cache
 
 from ar3cli.rules.base import Hit, engine_rule, robot, rule
 
@@ -98,8 +99,10 @@ NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
 """Element tag -> attribute -> how many numbers it must hold (0: one or three)."""
 
 
+@lru_cache(maxsize=4096)
 def number_problem(text: str, count: int) -> str | None:
-    """Why ``text`` is not ``count`` finite numbers, or None when it is fine."""
+    """Why ``text`` is not ``count`` finite numbers, or None when it is fine (cached: robot files
+    repeat the same few texts, "0 0 0", "1 0 0", thousands of times)."""
     parts = text.split()
     expected = (1, 3) if count == 0 else (count,)
     if len(parts) in expected:
