@@ -2,8 +2,8 @@
 
 A pre-commit hook or a CI step lints the same meshes again and again; reading 50 MB of OBJ and
 STL text takes longer than all the rules together. Facts are keyed by the file's absolute path
-(not resolved through symlinks: realpath costs more than the lookup it serves), modification time
-(ns) and size, so an edited mesh is read again. The cache is one JSON file per
+(not resolved through symlinks: realpath costs more than the lookup it serves), modification and
+status-change times (ns) and size, so an edited mesh is read again. The cache is one JSON file per
 kind of fact, written atomically at exit and only when something new was learnt; a corrupt or
 unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
 ``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
@@ -17,6 +17,7 @@ from __future__ import annotations
 import atexit
 import json
 import os
+import stat
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,20 @@ MAX_ENTRIES = 20_000
 """Beyond this many entries the oldest half is dropped when saving (the cache stays small)."""
 
 MISSING = object()
+
+PathState = tuple[int, int, int, int]
+"""What a path looks like now: (modification time, status-change time (ns), size, mode). The
+status-change time moves on every write, chmod or rename and cannot be set back (``touch -r``
+can restore a modification time, not this)."""
+
+
+def path_state(path: str) -> PathState | None:
+    """The state of ``path`` (symlinks followed), or None when nothing is there."""
+    try:
+        status = os.stat(path)
+    except (OSError, ValueError):
+        return None
+    return status.st_mtime_ns, status.st_ctime_ns, status.st_size, status.st_mode
 
 _OPEN: dict[str, FileFacts] = {}
 """This process's caches by name, for handing what a worker learnt to its parent."""
@@ -56,7 +71,7 @@ class FileFacts:
         _OPEN[name] = self
 
     def _key(self, path: Path, stat: os.stat_result) -> str:
-        return f"{os.path.abspath(path)}|{stat.st_mtime_ns}|{stat.st_size}"
+        return f"{os.path.abspath(path)}|{stat.st_mtime_ns}|{stat.st_ctime_ns}|{stat.st_size}"
 
     def _file(self) -> Path | None:
         folder = cache_dir()
@@ -66,13 +81,14 @@ class FileFacts:
         if self._entries is None:
             self._entries = {}
             location = self._file()
-            if location is not None:
-                try:
+            state = path_state(str(location)) if location is not None else None
+            if state is not None and stat.S_ISREG(state[3]):
+                try:  # a regular file only: a FIFO or /dev/zero in its place would never end
                     loaded = json.loads(location.read_text(encoding="utf-8"))
                     if isinstance(loaded, dict):
                         self._entries = loaded
-                except (OSError, ValueError):
-                    pass  # no cache yet, or a damaged one: start afresh
+                except (OSError, ValueError, RecursionError):
+                    pass  # a damaged cache (even one nested thousands deep): start afresh
         return self._entries
 
     def get(self, path: Path, stat: os.stat_result) -> Any:

@@ -93,6 +93,8 @@ class Context:
 
 def display_path(path: Path) -> str:
     """The path relative to the current directory when it is below it, else as given."""
+    if ".." in Path(path).parts:  # relpath would drop "link/.." although the OS follows the link
+        return str(path)
     try:
         relative = os.path.relpath(path)
     except ValueError:  # another drive on Windows
@@ -116,8 +118,9 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
         else:
             raise UserError(f"{path}: no such file or directory")
     unique: dict[str, Path] = {}
-    for path in found:
-        unique.setdefault(os.path.normpath(path), path)
+    for path in found:  # the same file named twice (by itself and by its folder) is linted once
+        folder, name = os.path.split(path)
+        unique.setdefault(os.path.join(os.path.realpath(folder or "."), name), path)
     return list(unique.values())
 
 

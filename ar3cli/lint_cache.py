@@ -4,14 +4,16 @@
 checks the same unchanged models again and again. Like ruff, ar3cli keeps each file's findings
 and reuses them while nothing they depend on has changed:
 
-* the file's path (as given and absolute), the selected rules and every option, the
-  ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH`` environment, and ar3cli itself (version and the
-  size and time of each of its source files), all hashed into the key: one entry per file;
+* the file's path (as given, absolute, and with every symlink resolved), the selected rules and
+  every option, the ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH`` environment, and ar3cli itself
+  (version and the size and time of each of its source files), all hashed into the key: one
+  entry per file;
 * the file's bytes (a hash of them, checked on every hit);
 * every path the package resolver looked at (meshes found or missing, ``package.xml`` files,
-  package folders), with its size, time and type, or its absence: checked again on every hit,
-  so a mesh that is edited, appears or disappears, or a ``package.xml`` that now names a package,
-  makes the result stale. The rules read no other file than these and the model itself.
+  package folders), with its state (times, size, mode, or absence) *when it was looked at*:
+  checked again on every hit, so a mesh that is edited, appears or disappears, or a
+  ``package.xml`` that now names a package, makes the result stale, even when the change happened
+  while the file was being checked. The rules read no other file than these and the model itself.
 
 Only static lints of ``.urdf`` files that loaded are remembered: xacro expansion reads includes
 that ar3cli does not see, and ``--sim`` results depend on PyBullet. ``--no-cache`` or
@@ -23,13 +25,12 @@ from __future__ import annotations
 
 import hashlib
 import os
-import stat
 import sys
-from collections.abc import Iterable
+from collections.abc import Mapping
 from pathlib import Path
 
 from ar3cli import __version__
-from ar3cli.cache import FileFacts
+from ar3cli.cache import FileFacts, PathState, path_state
 from ar3cli.findings import Finding, Severity
 
 MAX_RESULTS = 2_000
@@ -39,19 +40,6 @@ MAX_RESULTS = 2_000
 _STORE = FileFacts("lint-results", version=1, max_entries=MAX_RESULTS)
 _PACKAGE_DIR = Path(__file__).resolve().parent
 _ENVIRONMENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH")
-
-Signature = list[int] | None
-"""A path's state: [modification time (ns), size, file type], or None when it does not exist."""
-
-
-def signature(path: str) -> Signature:
-    """The state of ``path`` now (symlinks followed)."""
-    try:
-        status = os.stat(path)
-    except (OSError, ValueError):
-        return None
-    return [status.st_mtime_ns, status.st_size, stat.S_IFMT(status.st_mode)]
-
 
 def code_fingerprint() -> str:
     """ar3cli's version plus the size and time of each of its source files: an edited rule (or
@@ -85,9 +73,11 @@ class ResultCache:
         self._context = hashlib.sha256("\n".join(context).encode("utf-8", "surrogateescape")).digest()
 
     def _key(self, path: Path, shown: str) -> str:
-        """One entry per file and settings: a new version of a file replaces the old one."""
+        """One entry per file and settings: a new version of a file replaces the old one. The path
+        as given, as shown and with every symlink resolved: ``current/robot.urdf`` through a
+        re-pointed ``current`` link, or ``link/../robot.urdf``, is another file."""
         digest = hashlib.sha256(self._context)
-        for part in (os.path.abspath(path), shown):
+        for part in (os.path.abspath(path), os.path.realpath(path), shown):
             digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
         return digest.hexdigest()
 
@@ -100,21 +90,35 @@ class ResultCache:
         try:
             if entry["content"] != hashlib.sha256(content).hexdigest():
                 return None
-            if any(signature(dependency) != state for dependency, state in entry["depends"].items()):
+            if any(_as_stored(path_state(dependency)) != state for dependency, state in entry["depends"].items()):
                 return None
-            return [Finding(rule, Severity(severity), message, shown, line, column, hint)
-                    for rule, severity, message, line, column, hint in entry["findings"]]
+            return [_finding(shown, *fields) for fields in entry["findings"]]
         except (KeyError, TypeError, ValueError, AttributeError):  # none, or damaged: check the file
             return None
 
-    def put(self, path: Path, shown: str, content: bytes, findings: list[Finding], probed: Iterable[str]) -> None:
+    def put(self, path: Path, shown: str, content: bytes, findings: list[Finding],
+            depends: Mapping[str, PathState | None]) -> None:
         """Remember the findings of ``path`` as it was when read (``content``) and the state of every
-        path they depended on: one that appears, disappears or changes makes them stale."""
+        path they depended on *when it was looked at* (a path that changes while the file is being
+        checked then makes the entry stale at once)."""
         _STORE.store(self._key(path, shown), {
             "content": hashlib.sha256(content).hexdigest(),
-            "depends": {dependency: signature(dependency) for dependency in probed},
+            "depends": {dependency: _as_stored(state) for dependency, state in depends.items()},
             "findings": [[f.rule, f.severity.value, f.message, f.line, f.column, f.hint] for f in findings],
         })
+
+
+def _as_stored(state: PathState | None) -> list[int] | None:
+    """A state as JSON keeps it (a list)."""
+    return list(state) if state is not None else None
+
+
+def _finding(shown: str, rule, severity, message, line, column, hint) -> Finding:
+    """A remembered finding, its fields checked (a damaged store must not crash the output)."""
+    if not (isinstance(rule, str) and isinstance(message, str) and isinstance(hint, str)
+            and type(line) is int and type(column) is int):
+        raise TypeError("damaged entry")
+    return Finding(rule, Severity(severity), message, shown, line, column, hint)
 
 
 def _read(path: Path) -> bytes | None:

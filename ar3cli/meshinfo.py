@@ -42,7 +42,7 @@ _STL_RECORD = 50
 """Bytes per binary STL triangle: normal (3 float32), 3 vertices (9 float32), attribute (uint16)."""
 
 
-_DISK_CACHE = FileFacts("mesh-bounds", version=1)
+_DISK_CACHE = FileFacts("mesh-bounds", version=2)
 
 
 def is_lfs_pointer(path: Path) -> bool:
@@ -70,8 +70,15 @@ def mesh_bounds(path: Path) -> Bounds | None:
     except OSError:
         return None
     stored = _DISK_CACHE.get(path, stat)
+    if stored is None:
+        return None
     if stored is not MISSING:
-        return (tuple(stored[0]), tuple(stored[1])) if stored else None  # type: ignore[return-value]
+        try:
+            low, high = (tuple(map(float, stored[0])), tuple(map(float, stored[1])))
+            if len(low) == len(high) == 3:
+                return low, high  # type: ignore[return-value]
+        except (TypeError, ValueError, IndexError, KeyError):
+            pass  # a damaged entry: read the mesh again
     bounds = _mesh_bounds(path, stat.st_mtime_ns, stat.st_size)
     _DISK_CACHE.put(path, stat, [list(bounds[0]), list(bounds[1])] if bounds else None)
     return bounds

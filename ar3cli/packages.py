@@ -24,6 +24,8 @@ from functools import lru_cache
 from pathlib import Path
 from urllib.parse import unquote
 
+from ar3cli.cache import PathState, path_state
+
 _PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
 
 
@@ -64,7 +66,8 @@ def parse_package_paths(items: list[str] | None) -> dict[str, Path]:
 
 
 @lru_cache(maxsize=256)
-def _package_xml_name(folder: Path) -> str | None:
+def _package_xml_name(folder: Path, _state: PathState | None = None) -> str | None:
+    """The ``<name>`` in ``folder/package.xml`` (cached per state of the file: an edit is seen)."""
     manifest = folder / "package.xml"
     try:
         if not manifest.is_file():  # missing, or a pipe that would never end
@@ -95,17 +98,21 @@ class PackageResolver:
         self._ament_prefixes = [Path(p) for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
         self._packages: dict[str, tuple[Path | None, tuple[str, ...]]] = {}
         self._resolutions: dict[str, Resolution] = {}
-        self.probed: set[str] = set()
-        """Every path whose existence or content a resolution depended on (for the lint result cache)."""
+        self.probed: dict[str, PathState | None] = {}
+        """Every path a resolution depended on, with its state when first looked at (the lint result
+        cache stores these: the answer is stale when any of them changes)."""
 
     def _probe(self, path: Path) -> Path:
-        """``path``, remembered in :attr:`probed` (call it on every path before looking at the disk)."""
-        self.probed.add(str(path))
+        """``path``, its state remembered in :attr:`probed` (call it before looking at the disk)."""
+        key = str(path)
+        if key not in self.probed:
+            self.probed[key] = path_state(key)
         return path
 
     def _package_name(self, folder: Path) -> str | None:
-        self._probe(folder / "package.xml")
-        return _package_xml_name(folder)
+        manifest = folder / "package.xml"
+        self._probe(manifest)
+        return _package_xml_name(folder, self.probed[str(manifest)])
 
     def find_package(self, name: str) -> tuple[Path | None, tuple[str, ...]]:
         """Folder of package ``name`` and the candidates tried, following the module's order."""

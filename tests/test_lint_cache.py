@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 
 import pytest
@@ -160,3 +161,82 @@ def test_results_persist_between_processes(cli, tmp_path, write_urdf) -> None:
     assert json.loads(after.stdout)["findings"] == []  # the package.xml names the folder mypkg
     uncached = cli("lint-urdf", "-f", "json", "--no-config", "--no-cache", str(moved), env=env)
     assert uncached.stdout == after.stdout
+
+
+def test_a_repointed_symlinked_folder_is_another_file(store, loads, tmp_path, monkeypatch) -> None:
+    """current -> A (mesh present), then current -> B (same URDF bytes, no mesh): checked again."""
+    for name in ("A", "B"):
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "robot.urdf").write_text(MESH_ROBOT.format(uri="meshes/base.stl"))
+    write_stl(tmp_path / "A" / "meshes" / "base.stl", 0.1)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "current").symlink_to("A")
+    assert "G001" not in codes(Path("current/robot.urdf"))
+    (tmp_path / "current").unlink()
+    (tmp_path / "current").symlink_to("B")
+    assert "G001" in codes(Path("current/robot.urdf"))
+    assert len(loads) == 2
+
+
+def test_a_dotdot_through_a_symlink_is_not_merged_with_another_file(store, loads, tmp_path, monkeypatch) -> None:
+    """link/../r.urdf is sub/r.urdf (the OS follows the link), not r.urdf beside it."""
+    (tmp_path / "sub" / "deep").mkdir(parents=True)
+    text = MESH_ROBOT.format(uri="meshes/base.stl")
+    (tmp_path / "r.urdf").write_text(text)
+    (tmp_path / "sub" / "r.urdf").write_text(text)
+    write_stl(tmp_path / "sub" / "meshes" / "base.stl", 0.1)
+    (tmp_path / "link").symlink_to("sub/deep")
+    monkeypatch.chdir(tmp_path)
+    both = lint_paths([Path("link/../r.urdf"), Path("r.urdf")], LintOptions())
+    assert [r.path for r in both] == ["link/../r.urdf", "r.urdf"]
+    assert [{f.rule for f in r.findings} >= {"G001"} for r in both] == [False, True]
+    assert "G001" in codes(Path("r.urdf"))  # answered for r.urdf itself, not from sub/r.urdf's entry
+
+
+def test_a_dependency_that_changes_during_the_check_makes_the_entry_stale(store, loads, write_urdf, tmp_path,
+                                                                           monkeypatch) -> None:
+    """States are recorded when a path is looked at: a mesh deleted after that, before the entry is
+    stored, cannot hide behind its new state."""
+    import ar3cli.lint as engine
+
+    path = write_urdf(MESH_ROBOT.format(uri="meshes/part.stl"))
+    write_stl(tmp_path / "meshes" / "part.stl", 0.1)
+    real = engine._lint_model
+
+    def lint_then_delete(*args, **kwargs):
+        result = real(*args, **kwargs)
+        (tmp_path / "meshes" / "part.stl").unlink()  # e.g. a git checkout while the hook runs
+        return result
+
+    monkeypatch.setattr(engine, "_lint_model", lint_then_delete)
+    assert "G001" not in codes(path)
+    monkeypatch.setattr(engine, "_lint_model", real)
+    assert "G001" in codes(path)
+    assert len(loads) == 2
+
+
+@pytest.mark.parametrize("damage", ["nested", "fifo", "types"])
+def test_a_damaged_store_never_breaks_a_run(store, cli, write_urdf, damage, tmp_path) -> None:
+    path = write_urdf(MESH_ROBOT.format(uri="meshes/part.stl").replace('name="r"', ""))  # S001: no name
+    write_stl(tmp_path / "meshes" / "part.stl", 0.1)
+    env = {"AR3CLI_CACHE_DIR": str(store)}
+    clean = cli("lint-urdf", "--no-cache", "--no-config", "-f", "sarif", str(path), env=env)
+    cli("lint-urdf", "--no-config", str(path), env=env)
+    results = store / "lint-results-v1.json"
+    meshes = store / "mesh-bounds-v2.json"
+    if damage == "nested":
+        for target in (results, meshes):
+            target.write_text("[" * 5000 + "]" * 5000)
+    elif damage == "fifo":
+        results.unlink()
+        os.mkfifo(results)
+    else:
+        entries = json.loads(results.read_text())
+        for entry in entries.values():
+            entry["findings"] = [[f[0], f[1], None, [1], f[4], f[5]] for f in entry["findings"]]
+        results.write_text(json.dumps(entries))
+        meshes.write_text(json.dumps({key: "junk" for key in json.loads(meshes.read_text())}))
+    for fmt in ("sarif", "github", "json"):
+        result = cli("lint-urdf", "--no-config", "-f", fmt, str(path), env=env, timeout=60)
+        assert result.code == 1 and "error" not in result.stderr, result.stderr
+    assert cli("lint-urdf", "--no-config", "-f", "sarif", str(path), env=env).stdout == clean.stdout

@@ -80,13 +80,13 @@ def test_disk_cache_reuses_and_invalidates(tmp_path, monkeypatch):
     mesh.write_text("v 0 0 0\nv 1 2 3\n")
 
     def fresh_bounds():
-        meshinfo._DISK_CACHE = cache.FileFacts("mesh-bounds", version=1)  # a new process, in effect
+        meshinfo._DISK_CACHE = cache.FileFacts("mesh-bounds", version=2)  # a new process, in effect
         meshinfo._mesh_bounds.cache_clear()
         return meshinfo.mesh_bounds(mesh)
 
     assert fresh_bounds() == ((0.0, 0.0, 0.0), (1.0, 2.0, 3.0))
     meshinfo._DISK_CACHE.save()
-    stored = next((tmp_path / "cache").glob("mesh-bounds-v1.json"))
+    stored = next((tmp_path / "cache").glob("mesh-bounds-v2.json"))
     import json
 
     entries = json.loads(stored.read_text())
