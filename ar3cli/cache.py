@@ -132,9 +132,19 @@ class FileFacts:
             pass
 
 
+def file_facts(name: str, version: int, max_entries: int = MAX_ENTRIES) -> FileFacts:
+    """This process's cache ``name`` (created on first use): one object per cache, however it is
+    reached (a module that owns it, or facts handed over by a worker before that module loaded)."""
+    existing = _OPEN.get(name)
+    if existing is not None and existing.version == version:
+        return existing
+    return FileFacts(name, version, max_entries)
+
+
 def take_learned() -> dict[str, dict[str, Any]]:
-    """What this process's caches learnt since the last call, by cache name (a worker's gift to its parent)."""
-    learned = {name: facts._learned for name, facts in _OPEN.items() if facts._learned}
+    """What this process's caches learnt since the last call (a worker's gift to its parent)."""
+    learned = {name: {"version": facts.version, "max_entries": facts.max_entries, "entries": facts._learned}
+               for name, facts in _OPEN.items() if facts._learned}
     for facts in _OPEN.values():
         facts._learned = {}
     return learned
@@ -142,6 +152,5 @@ def take_learned() -> dict[str, dict[str, Any]]:
 
 def merge_learned(learned: dict[str, dict[str, Any]]) -> None:
     """Add what a worker learnt (:func:`take_learned`) to this process's caches, saved at exit."""
-    for name, entries in learned.items():
-        if name in _OPEN and entries:
-            _OPEN[name]._merge(entries)
+    for name, gift in learned.items():
+        file_facts(name, gift["version"], gift["max_entries"])._merge(gift["entries"])

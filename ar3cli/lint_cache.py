@@ -30,14 +30,14 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ar3cli import __version__
-from ar3cli.cache import FileFacts, PathState, path_state
+from ar3cli.cache import PathState, file_facts, path_state
 from ar3cli.findings import Finding, Severity
 
 MAX_RESULTS = 2_000
 """Remembered files; beyond this the oldest half is dropped. Every run reads the whole store
 (0.5 to 2.5 kB a file: pybullet_data's 1101 files make 0.5 MB, read in ~4 ms)."""
 
-_STORE = FileFacts("lint-results", version=1, max_entries=MAX_RESULTS)
+_STORE = file_facts("lint-results", version=1, max_entries=MAX_RESULTS)
 _PACKAGE_DIR = Path(__file__).resolve().parent
 _ENVIRONMENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH")
 

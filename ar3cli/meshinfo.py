@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
 
-from ar3cli.cache import MISSING, FileFacts
+from ar3cli.cache import MISSING, file_facts
 
 LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 LFS_POINTER_MAX_BYTES = 1024
@@ -42,7 +42,7 @@ _STL_RECORD = 50
 """Bytes per binary STL triangle: normal (3 float32), 3 vertices (9 float32), attribute (uint16)."""
 
 
-_DISK_CACHE = FileFacts("mesh-bounds", version=2)
+_DISK_CACHE = file_facts("mesh-bounds", version=2)
 
 
 def is_lfs_pointer(path: Path) -> bool:

@@ -15,7 +15,7 @@ import os
 import signal
 import sys
 from collections.abc import Callable, Sequence
-from typing import TypeVar
+from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import UserError
 
@@ -40,10 +40,11 @@ def available_cpus() -> int:
 
 
 def worker_count(requested: int | None, items: int, min_items_per_worker: int) -> int:
-    """Processes to use: ``requested`` when given (at most one per item); otherwise one per CPU as
-    long as each gets ``min_items_per_worker`` items, and 1 where forking is not available."""
+    """Processes to use: one per ``min_items_per_worker`` items, at most one per CPU (and
+    :data:`MAX_AUTO_WORKERS`), 1 where forking is not available; ``requested`` overrides the rule
+    but not the limits of one per item and one per CPU (more would only compete for them)."""
     if requested is not None:
-        return max(1, min(requested, items))
+        return max(1, min(requested, items, available_cpus()))
     if not can_fork():
         return 1
     return max(1, min(available_cpus(), MAX_AUTO_WORKERS, items // min_items_per_worker))
@@ -54,55 +55,83 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
     """``[function(item) for item in items]`` with the items dealt round-robin to ``workers``
     processes, this one included. Results must pickle. A child's UserError is raised here as it
     is, any other exception as a RuntimeError (an internal error); a child that dies (a crash in C
-    code) becomes a one-line UserError naming ``what`` was running. Never a hang."""
+    code) becomes a one-line UserError naming ``what`` was running. Never a hang: if this process
+    fails or is interrupted, the children are stopped (given time to clean up first); a child whose
+    parent died stops at its next item. When the system refuses another process or pipe, this
+    process takes that share itself."""
     if workers <= 1 or len(items) <= 1 or not can_fork():
         return [function(item) for item in items]
     workers = min(workers, len(items))
-    children: list[tuple[int, int]] = []
+    children: dict[int, tuple[int, BinaryIO]] = {}  # share number -> (pid, the pipe it answers through)
     try:
-        for index in range(1, workers):
-            children.append(_start_child(function, items[index::workers]))
-        shares = [[function(item) for item in items[0::workers]]]
-        while children:
-            data = _read_and_reap(*children[0])
-            children.pop(0)
-            shares.append(_unpack(data, what))
+        for number in range(1, workers):
+            child = _start_child(function, items[number::workers])
+            if child is None:
+                break  # this process takes the shares left over
+            children[number] = child
+        shares = {number: [function(item) for item in items[number::workers]]
+                  for number in range(workers) if number not in children}
+        for number, (pid, pipe) in list(children.items()):
+            data = _read_and_reap(pid, pipe)
+            del children[number]
+            shares[number] = _unpack(data, what)
     finally:
-        for pid, pipe in children:  # this process failed or was interrupted: stop the others
-            _stop(pid, pipe)
+        _stop(list(children.values()))  # this process failed or was interrupted: stop the others
     results: list[Result] = [None] * len(items)  # type: ignore[list-item]
-    for index, share in enumerate(shares):
-        results[index::workers] = share
+    for number, share in shares.items():
+        results[number::workers] = share
     return results
 
 
-def _start_child(function: Callable[[Item], Result], share: Sequence[Item]) -> tuple[int, int]:
-    """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe."""
+def _start_child(function: Callable[[Item], Result], share: Sequence[Item]) -> tuple[int, BinaryIO] | None:
+    """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe;
+    None when the system refuses a pipe or a process (too many open files or processes)."""
     import pickle
 
-    read_end, write_end = os.pipe()
-    pid = os.fork()
-    if pid == 0:  # the child: never returns
-        os.close(read_end)
+    parent = os.getpid()
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})  # no Ctrl-C between fork and bookkeeping
+    try:
         try:
+            read_end, write_end = os.pipe()
+        except OSError:
+            return None
+        try:
+            pid = os.fork()
+        except OSError:
+            os.close(read_end)
+            os.close(write_end)
+            return None
+        if pid == 0:  # the child: never returns
             try:
-                outcome: tuple = ("ok", [function(item) for item in share])
-            except UserError as exc:
-                outcome = ("user-error", (exc.message, exc.exit_code))
-            except BaseException as exc:  # noqa: BLE001 - reported by the parent
-                outcome = ("error", f"{type(exc).__name__}: {exc}")
-            with os.fdopen(write_end, "wb") as pipe:
-                pickle.dump(outcome, pipe, protocol=pickle.HIGHEST_PROTOCOL)
-        finally:
-            os._exit(0)
-    os.close(write_end)
-    return pid, read_end
+                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+                os.close(read_end)
+                try:
+                    outcome: tuple = ("ok", [_unless_orphaned(parent, function, item) for item in share])
+                except UserError as exc:
+                    outcome = ("user-error", (exc.message, exc.exit_code))
+                except BaseException as exc:  # noqa: BLE001 - reported by the parent
+                    outcome = ("error", f"{type(exc).__name__}: {exc}")
+                with os.fdopen(write_end, "wb") as pipe:
+                    pickle.dump(outcome, pipe, protocol=pickle.HIGHEST_PROTOCOL)
+            finally:
+                os._exit(0)
+        os.close(write_end)
+        return pid, os.fdopen(read_end, "rb")
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
 
 
-def _read_and_reap(pid: int, pipe: int) -> bytes:
+def _unless_orphaned(parent: int, function: Callable[[Item], Result], item: Item) -> Result:
+    """``function(item)`` in a child, which first ends itself if its parent is gone (killed)."""
+    if os.getppid() != parent:
+        os._exit(1)
+    return function(item)
+
+
+def _read_and_reap(pid: int, pipe: BinaryIO) -> bytes:
     """Everything the child wrote (read to the end first, so a large answer cannot block it)."""
-    with os.fdopen(pipe, "rb") as stream:
-        data = stream.read()
+    with pipe:
+        data = pipe.read()
     os.waitpid(pid, 0)
     return data
 
@@ -123,13 +152,45 @@ def _unpack(data: bytes, what: str) -> list:
     return payload
 
 
-def _stop(pid: int, pipe: int) -> None:
-    try:
-        os.kill(pid, signal.SIGTERM)
-        os.waitpid(pid, 0)
-    except OSError:
-        pass
-    try:
-        os.close(pipe)
-    except OSError:
-        pass
+SETTLE_SECONDS = 0.5
+"""After Ctrl-C (which the children get too) a child is left this long to clean up on its own
+(a PyBullet session removes its temporary folder) before it is asked to stop."""
+STOP_SECONDS = 3.0
+"""A child asked to stop (SIGINT) gets this long before it is killed."""
+
+
+def _stop(children: list[tuple[int, BinaryIO]]) -> None:
+    """End the remaining children: closed pipes, a moment to finish, SIGINT, then SIGKILL."""
+    for _, pipe in children:
+        pipe.close()  # a child still writing its answer gets EPIPE and ends
+    running = {pid for pid, _ in children}
+    for action, seconds in ((None, SETTLE_SECONDS), (signal.SIGINT, STOP_SECONDS), (signal.SIGKILL, None)):
+        for pid in running if action else ():
+            try:
+                os.kill(pid, action)
+            except ProcessLookupError:
+                pass
+        running = _reap(running, seconds)
+        if not running:
+            return
+
+
+def _reap(pids: set[int], seconds: float | None) -> set[int]:
+    """Wait up to ``seconds`` (None: as long as it takes) for ``pids`` to end; those still running."""
+    import time
+
+    deadline = None if seconds is None else time.monotonic() + seconds
+    running = set(pids)
+    while running:
+        for pid in list(running):
+            try:
+                done, _ = os.waitpid(pid, 0 if deadline is None else os.WNOHANG)
+            except ChildProcessError:
+                done = pid
+            if done:
+                running.discard(pid)
+        if running and deadline is not None:
+            if time.monotonic() >= deadline:
+                break
+            time.sleep(0.01)
+    return running

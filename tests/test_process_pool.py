@@ -76,6 +76,7 @@ def test_worker_count(monkeypatch) -> None:
     monkeypatch.setattr(process_pool, "available_cpus", lambda: 4)
     assert worker_count(3, items=100, min_items_per_worker=24) == 3  # asked for: used
     assert worker_count(8, items=2, min_items_per_worker=24) == 2  # never more than the items
+    assert worker_count(2000, items=1000, min_items_per_worker=24) == 4  # nor than the CPUs
     assert worker_count(None, items=23, min_items_per_worker=24) == 1  # too few to repay a fork
     assert worker_count(None, items=50, min_items_per_worker=24) == 2
     assert worker_count(None, items=1000, min_items_per_worker=24) == 4  # one per CPU
@@ -97,3 +98,126 @@ def test_lint_output_and_caches_do_not_depend_on_jobs(cli, tmp_path, pybullet_da
         loaded = [f for f in json.loads(result.stdout)["files"] if f["loaded"]]
         assert len(remembered) == len(loaded) > 20
     assert outputs[1] == outputs[3]
+
+
+def test_when_the_system_refuses_a_process_this_one_does_the_work(monkeypatch, no_children_left) -> None:
+    calls = []
+    real_fork = os.fork
+
+    def fork_twice_then_refuse():
+        calls.append(1)
+        if len(calls) > 2:
+            raise BlockingIOError(11, "Resource temporarily unavailable")
+        return real_fork()
+
+    monkeypatch.setattr(os, "fork", fork_twice_then_refuse)
+    results = map_in_processes(square_with_pid, list(range(30)), 6)
+    assert [value for value, _ in results] == [i * i for i in range(30)]
+    assert len({pid for _, pid in results}) == 3  # this process and the two children it got
+
+
+ORPHAN_SCRIPT = """
+import os, signal, sys, time
+from ar3cli.process_pool import map_in_processes
+PARENT = os.getpid()
+def work(item):
+    if os.getpid() != PARENT:
+        open(sys.argv[1], "a").write(f"{os.getpid()}\\n")
+    time.sleep(0.1)
+    if os.getpid() == PARENT and item == 4:
+        os.kill(PARENT, signal.SIGKILL)  # as `kill -9` or a timeout would end it
+    return item
+map_in_processes(work, list(range(200)), 2)
+"""
+
+
+def test_a_child_whose_parent_is_killed_stops(tmp_path) -> None:
+    import subprocess
+    import sys
+    import time
+
+    from tests.conftest import REPO
+
+    record = tmp_path / "child.txt"
+    run = subprocess.run([sys.executable, "-c", ORPHAN_SCRIPT, str(record)], env={**os.environ, "PYTHONPATH": str(REPO)},
+                         timeout=60)
+    assert run.returncode == -signal.SIGKILL
+    child = int(record.read_text().split()[0])
+    deadline = time.monotonic() + 5  # its next item starts within 0.1 s; 100 items would take 10 s
+    while time.monotonic() < deadline and _alive(child):
+        time.sleep(0.05)
+    assert not _alive(child)
+
+
+def _alive(pid: int) -> bool:
+    """Running (a zombie waiting for a reaper counts as ended)."""
+    try:
+        with open(f"/proc/{pid}/stat", encoding="ascii") as status:
+            return status.read().rsplit(")", 1)[1].split()[0] != "Z"
+    except FileNotFoundError:
+        return False
+
+
+def test_facts_a_child_learnt_are_saved_even_if_this_process_never_needed_that_cache(cli, tmp_path,
+                                                                                  pybullet_data_dir) -> None:
+    """The parent lints files without meshes (it never loads the mesh cache); the child lints the
+    KUKA, whose mesh boxes must still reach the parent's store."""
+    models = [pybullet_data_dir / "cartpole.urdf", pybullet_data_dir / "block.urdf",
+              pybullet_data_dir / "kuka_iiwa" / "model.urdf"]
+    cache = tmp_path / "cache"
+    result = cli("lint-urdf", "--no-config", "--select", "I007", "--jobs", "2", *map(str, models),
+                 env={"AR3CLI_CACHE_DIR": str(cache)})
+    assert result.code in (0, 1), result.stderr
+    boxes = json.loads((cache / "mesh-bounds-v2.json").read_text())
+    assert any("kuka_iiwa" in key for key in boxes)
+
+
+def test_ctrl_c_during_a_parallel_sim_lint_leaves_no_temporary_folder(tmp_path, pybullet_data_dir) -> None:
+    """Ctrl-C reaches every process of the group; children get time to close their PyBullet
+    sessions (which remove their temporary copies) before they are stopped."""
+    import subprocess
+    import sys
+    import time
+
+    from tests.conftest import REPO
+
+    names = ["r2d2.urdf", "kuka_iiwa/model.urdf", "franka_panda/panda.urdf", "quadruped/minitaur.urdf",
+             "a1/a1.urdf", "laikago/laikago.urdf", "husky/husky.urdf", "racecar/racecar.urdf"]
+    temporary = tmp_path / "tmp"
+    temporary.mkdir()
+    env = {**os.environ, "PYTHONPATH": str(REPO), "TMPDIR": str(temporary), "AR3CLI_CACHE_DIR": str(tmp_path / "c")}
+    for delay in (0.8, 1.4):
+        run = subprocess.Popen([sys.executable, "-m", "ar3cli", "lint-urdf", "--sim", "--jobs", "2", "-f", "json",
+                                *(str(pybullet_data_dir / name) for name in names)],
+                               env=env, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+        time.sleep(delay)
+        os.killpg(run.pid, signal.SIGINT)
+        _, stderr = run.communicate(timeout=60)
+        assert run.returncode in (130, 1), stderr  # 1: it finished first
+        assert "Traceback" not in stderr.decode()
+        assert run.returncode == 1 or stderr.decode().strip().splitlines() == ["ar3cli: interrupted"]
+        assert sorted(p.name for p in temporary.iterdir()) == []
+
+
+def test_a_child_being_stopped_gets_to_clean_up(tmp_path, no_children_left) -> None:
+    """When this process fails, a child is asked to stop with SIGINT (its finally blocks run: a
+    PyBullet session removes its temporary folder), not killed outright."""
+    import time
+
+    marker = tmp_path / "cleaned"
+
+    def work(item: int) -> int:
+        if item == 0:  # this process's share: it fails while the child works
+            time.sleep(0.2)
+            raise ValueError("this process failed")
+        try:
+            time.sleep(30)
+        finally:
+            time.sleep(0.2)
+            marker.write_text("done")
+        return item
+
+    started = time.monotonic()
+    with pytest.raises(ValueError, match="this process failed"):
+        map_in_processes(work, [0, 1], 2)
+    assert marker.read_text() == "done" and time.monotonic() - started < 10

@@ -50,9 +50,10 @@ def lint_urdf(
     no_config: Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
     = False,
     jobs: Annotated[Optional[int], typer.Option("--jobs", "-j", min=1, show_default=False,
-                                                help="Processes that share the files. Default on Linux: one "
-                                                     "per CPU (at most 8) for 24+ files, or 2+ with --sim; "
-                                                     "1 elsewhere. The output is the same for any value.")]
+                                                help="Processes that share the files, at most one per CPU. "
+                                                     "Default on Linux: one per 24 files (per 2 with --sim), "
+                                                     "at most 8; elsewhere 1. The output is the same for any "
+                                                     "value.")]
     = None,
     no_cache: Annotated[bool, typer.Option("--no-cache", help="Check every file again instead of reusing the "
                                                               "findings of unchanged files from earlier runs "
