@@ -5,19 +5,20 @@ Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad inp
 ``AR3CLI_DEBUG=1`` to see the traceback).
 """
 
+import errno
 import os
 import sys
 
 import typer
 
 from ar3cli import __version__
+from ar3cli.commands.fix_continuous import fix_continuous
+from ar3cli.commands.fix_inertia import fix_inertia
+from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.commands.grasp_demo import grasp_demo
 from ar3cli.commands.install_check import install_check
-from ar3cli.commands.render import render_command
-from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.commands.lint_urdf import lint_urdf
-from ar3cli.commands.fix_inertia import fix_inertia
-from ar3cli.commands.fix_continuous import fix_continuous
+from ar3cli.commands.render import render_command
 from ar3cli.commands.sample_collisions import sample_collisions
 from ar3cli.errors import EXIT_INTERNAL, EXIT_USAGE, UserError
 
@@ -77,9 +78,13 @@ def main(argv: list[str] | None = None) -> None:
     box to ``ar3cli: error: <what> (see 'ar3cli COMMAND --help')`` with exit code 2, like every
     other input error.
     """
+    _reopen_closed_standard_streams()
     usage_error, no_args = _click_exceptions()
     try:
         code = app(args=argv, prog_name="ar3cli", standalone_mode=False)
+        sys.stdout.flush()  # a full disk or a closed pipe is reported here, not at interpreter exit
+        if code == 130:  # typer turns Ctrl-C into Exit(130)
+            print("ar3cli: interrupted", file=sys.stderr)
         sys.exit(code if isinstance(code, int) else 0)
     except no_args as exc:  # `ar3cli` alone, or a group without a command: show the help
         exc.show()
@@ -98,9 +103,43 @@ def main(argv: list[str] | None = None) -> None:
     except KeyboardInterrupt:
         print("ar3cli: interrupted", file=sys.stderr)
         sys.exit(130)
+    except BrokenPipeError:  # the reader went away (`| head`): nothing more to say to it
+        _discard_stdout()
+        sys.exit(EXIT_USAGE)
+    except OSError as exc:
+        if exc.errno not in (errno.ENOSPC, errno.EDQUOT, errno.EIO):
+            raise
+        _discard_stdout()
+        print(f"ar3cli: error: cannot write the output: {exc.strerror}", file=sys.stderr)
+        sys.exit(EXIT_USAGE)
     except Exception as exc:  # a bug in ar3cli: one line unless debugging
         if os.environ.get("AR3CLI_DEBUG"):
             raise
         print(f"ar3cli: internal error: {type(exc).__name__}: {exc} (rerun with AR3CLI_DEBUG=1 for a traceback "
               "and report it)", file=sys.stderr)
         sys.exit(EXIT_INTERNAL)
+
+
+def _reopen_closed_standard_streams() -> None:
+    """Closed stdin, stdout or stderr (``>&-``, ``2>&-``) become /dev/null. Otherwise the next file
+    opened takes their number, and capturing pybullet's C output (which duplicates descriptors 1
+    and 2) mixes them up; Python also leaves ``sys.stdout`` as None."""
+    for fd in (0, 1, 2):
+        try:
+            os.fstat(fd)
+        except OSError:
+            os.open(os.devnull, os.O_RDWR)  # the lowest free number: this one
+    if sys.stdout is None:
+        sys.stdout = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115 - lives as long as the process
+    if sys.stderr is None:
+        sys.stderr = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115
+
+
+def _discard_stdout() -> None:
+    """Point descriptor 1 at /dev/null, so the text still buffered is dropped quietly at exit."""
+    try:
+        null = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(null, 1)
+        os.close(null)
+    except OSError:
+        pass

@@ -42,3 +42,29 @@ def test_help_texts_survive_markdown_rendering():
         texts = [command.help or ""] + [getattr(param, "help", None) or "" for param in command.params]
         for text in texts:
             assert not bare_tag.search(text), f"ar3cli {name}: help text {text!r} has a bare <tag>"
+
+
+def shell(command: str) -> "subprocess.CompletedProcess[bytes]":
+    """Run ``python -m ar3cli COMMAND`` through the shell (for redirections such as ``>&-``)."""
+    import os
+    import subprocess
+    import sys
+
+    from tests.conftest import REPO
+
+    return subprocess.run(f"{sys.executable} -m ar3cli {command}", shell=True, capture_output=True, cwd=REPO,
+                          env={**os.environ, "PYTHONPATH": str(REPO), "NO_COLOR": "1"}, timeout=300)
+
+
+def test_closed_or_full_standard_streams():
+    """stderr closed with --sim (pybullet's C output is captured by duplicating descriptors 1 and
+    2), stdout closed, stdout on a full disk: clean JSON, an exit code, one line, no traceback."""
+    import json
+
+    no_stderr = shell("lint-urdf --sim --format json assets/ar3/ar3.urdf 2>&-")
+    assert no_stderr.returncode == 0 and json.loads(no_stderr.stdout)["summary"]["files"] == 1
+    no_stdout = shell("lint-urdf --format json assets/examples/ar3_no_inertia.urdf >&-")
+    assert no_stdout.returncode == 1 and no_stdout.stderr == b""
+    full = shell("lint-urdf --format json assets/ar3/ar3.urdf > /dev/full")
+    assert full.returncode == 2
+    assert full.stderr.decode().splitlines() == ["ar3cli: error: cannot write the output: No space left on device"]
