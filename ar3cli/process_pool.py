@@ -65,7 +65,7 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
     children: dict[int, tuple[int, BinaryIO]] = {}  # share number -> (pid, the pipe it answers through)
     try:
         for number in range(1, workers):
-            child = _start_child(function, items[number::workers])
+            child = _start_child(function, items[number::workers], [pipe for _, pipe in children.values()])
             if child is None:
                 break  # this process takes the shares left over
             children[number] = child
@@ -83,9 +83,12 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
     return results
 
 
-def _start_child(function: Callable[[Item], Result], share: Sequence[Item]) -> tuple[int, BinaryIO] | None:
+def _start_child(function: Callable[[Item], Result], share: Sequence[Item],
+                 siblings: list[BinaryIO]) -> tuple[int, BinaryIO] | None:
     """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe;
-    None when the system refuses a pipe or a process (too many open files or processes)."""
+    None when the system refuses a pipe or a process (too many open files or processes). The child
+    closes its copies of the ``siblings``' pipes: only the parent may hold a reader, so a child
+    whose parent died gets EPIPE instead of waiting on a full pipe."""
     import pickle
 
     parent = os.getpid()
@@ -105,6 +108,8 @@ def _start_child(function: Callable[[Item], Result], share: Sequence[Item]) -> t
             try:
                 signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
                 os.close(read_end)
+                for pipe in siblings:
+                    pipe.close()
                 try:
                     outcome: tuple = ("ok", [_unless_orphaned(parent, function, item) for item in share])
                 except UserError as exc:
