@@ -4,8 +4,9 @@ A pre-commit hook or a CI step lints the same meshes again and again; reading 50
 STL text takes longer than all the rules together. Facts are keyed by the file's absolute path
 (not resolved through symlinks: realpath costs more than the lookup it serves), modification and
 status-change times (ns) and size, so an edited mesh is read again. The cache is one JSON file per
-kind of fact, written atomically at exit and only when something new was learnt; a corrupt or
-unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
+kind of fact, written atomically at exit and only when something new was learnt, merged under a
+lock with what other ar3cli processes saved meanwhile (pre-commit runs several at once); a corrupt
+or unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
 ``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
 
 A forked worker process (:mod:`ar3cli.process_pool`) never saves: it hands what it learnt to its
@@ -15,14 +16,16 @@ parent (:func:`take_learned`), which merges it (:func:`merge_learned`) and saves
 from __future__ import annotations
 
 import atexit
+import contextlib
 import json
 import os
 import stat
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 MAX_ENTRIES = 20_000
-"""Beyond this many entries the oldest half is dropped when saving (the cache stays small)."""
+"""Beyond this many entries the least recently stored are dropped when saving (the cache stays small)."""
 
 MISSING = object()
 
@@ -39,6 +42,21 @@ def path_state(path: str) -> PathState | None:
     except (OSError, ValueError):
         return None
     return status.st_mtime_ns, status.st_ctime_ns, status.st_size, status.st_mode
+
+
+def read_regular_file(path: str) -> bytes | None:
+    """The bytes of ``path`` if it is a regular file, else None. Opened without blocking and
+    checked on the open descriptor, so a FIFO (which would wait for a writer forever) cannot
+    slip in between a check and the read."""
+    try:
+        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
+    except OSError:
+        return None
+    with os.fdopen(descriptor, "rb") as handle:
+        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
+            return None
+        return handle.read()
+
 
 _OPEN: dict[str, FileFacts] = {}
 """This process's caches by name, for handing what a worker learnt to its parent."""
@@ -67,11 +85,14 @@ class FileFacts:
         self.max_entries = max_entries
         self._entries: dict[str, Any] | None = None
         self._dirty = False
+        self._changed: dict[str, Any] = {}
+        """Entries stored or merged by this process: what :meth:`save` writes."""
         self._learned: dict[str, Any] = {}
+        """Entries stored since :func:`take_learned` last asked (a worker's answer to its parent)."""
         _OPEN[name] = self
 
-    def _key(self, path: Path, stat: os.stat_result) -> str:
-        return f"{os.path.abspath(path)}|{stat.st_mtime_ns}|{stat.st_ctime_ns}|{stat.st_size}"
+    def _key(self, path: Path, status: os.stat_result) -> str:
+        return f"{os.path.abspath(path)}|{status.st_mtime_ns}|{status.st_ctime_ns}|{status.st_size}"
 
     def _file(self) -> Path | None:
         folder = cache_dir()
@@ -79,25 +100,17 @@ class FileFacts:
 
     def _load(self) -> dict[str, Any]:
         if self._entries is None:
-            self._entries = {}
             location = self._file()
-            state = path_state(str(location)) if location is not None else None
-            if state is not None and stat.S_ISREG(state[3]):
-                try:  # a regular file only: a FIFO or /dev/zero in its place would never end
-                    loaded = json.loads(location.read_text(encoding="utf-8"))
-                    if isinstance(loaded, dict):
-                        self._entries = loaded
-                except (OSError, ValueError, RecursionError):
-                    pass  # a damaged cache (even one nested thousands deep): start afresh
+            self._entries = _read_entries(location) if location is not None else {}
         return self._entries
 
-    def get(self, path: Path, stat: os.stat_result) -> Any:
+    def get(self, path: Path, status: os.stat_result) -> Any:
         """The stored fact for this version of ``path``, or :data:`MISSING`."""
-        return self.lookup(self._key(path, stat))
+        return self.lookup(self._key(path, status))
 
-    def put(self, path: Path, stat: os.stat_result, value: Any) -> None:
+    def put(self, path: Path, status: os.stat_result, value: Any) -> None:
         """Remember ``value`` (JSON-serialisable) for this version of ``path``; saved at exit."""
-        self.store(self._key(path, stat), value)
+        self.store(self._key(path, status), value)
 
     def lookup(self, key: str) -> Any:
         """The value stored under ``key``, or :data:`MISSING`."""
@@ -109,27 +122,64 @@ class FileFacts:
         self._merge({key: value})
 
     def _merge(self, entries: dict[str, Any]) -> None:
-        self._load().update(entries)
+        loaded = self._load()
+        for key, value in entries.items():
+            loaded.pop(key, None)  # stored again: it moves to the end, the newest
+            loaded[key] = value
+        self._changed.update(entries)
         if not self._dirty and self._file() is not None:
             atexit.register(self.save)
         self._dirty = True
 
     def save(self) -> None:
-        """Write the cache atomically if it changed; failures are silent (a cache is optional)."""
+        """Write what this process stored into the cache file, atomically and under a lock, on top
+        of what is there now (other processes may have saved since this one read it); only the
+        newest :attr:`max_entries` are kept. Failures are silent (a cache is optional)."""
         location = self._file()
-        if not self._dirty or location is None or self._entries is None:
+        if not self._dirty or location is None:
             return
-        entries = self._entries
-        if len(entries) > self.max_entries:
-            entries = dict(list(entries.items())[len(entries) // 2:])
         try:
             from ar3cli.atomic import atomic_write
 
             location.parent.mkdir(parents=True, exist_ok=True)
-            atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"))
+            with _locked(location.with_name(location.name + ".lock")):
+                entries = _read_entries(location)
+                for key, value in self._changed.items():
+                    entries.pop(key, None)
+                    entries[key] = value
+                if len(entries) > self.max_entries:
+                    entries = dict(list(entries.items())[-self.max_entries:])
+                atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"))
             self._dirty = False
         except Exception:  # noqa: BLE001 - a read-only home must never break a lint
             pass
+
+
+def _read_entries(location: Path) -> dict[str, Any]:
+    """The cache file's entries; {} when there is none, or a damaged one (junk, JSON nested
+    thousands deep, a pipe in its place)."""
+    data = read_regular_file(str(location))
+    try:
+        loaded = json.loads(data) if data else {}
+    except (ValueError, RecursionError):
+        return {}
+    return loaded if isinstance(loaded, dict) else {}
+
+
+@contextlib.contextmanager
+def _locked(lock_path: Path) -> Iterator[None]:
+    """Hold an exclusive lock on ``lock_path`` (POSIX ``flock``; elsewhere no lock)."""
+    try:
+        import fcntl
+    except ImportError:  # Windows: concurrent saves may drop each other's new entries
+        yield
+        return
+    with open(lock_path, "a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
 
 
 def file_facts(name: str, version: int, max_entries: int = MAX_ENTRIES) -> FileFacts:
