@@ -17,11 +17,15 @@ import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from ar3cli.cache import cache_dir, merge_learned, take_learned
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
 from ar3cli.rules import REGISTRY, RULES, Hit, Rule, matches
+
+if TYPE_CHECKING:
+    from ar3cli.lint_cache import ResultCache
 
 ROBOT_SUFFIXES = (".urdf", ".xacro")
 _SKIP_DIRS = {".git", ".hg", ".svn", "__pycache__", "node_modules", ".venv", "venv", ".tox"}
@@ -149,39 +153,33 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
         return [lint_file(path, rules, options, cache) for path in files]
     # The first file is checked before forking: the imports and caches it loads are then shared.
     first = lint_file(files[0], rules, options, cache)
+    take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
     outcomes = map_in_processes(job, files[1:], workers, what="a lint worker")
-    from ar3cli.cache import merge_learned
-
     for _, learned in outcomes:
         merge_learned(learned)
     return [first, *(result for result, _ in outcomes)]
 
 
-def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions, cache) -> tuple[FileResult, dict]:
+def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions,
+                         cache: ResultCache | None) -> tuple[FileResult, dict[str, Any]]:
     """:func:`lint_file`, plus what the on-disk caches learnt meanwhile (a worker never saves them:
     its parent merges and saves)."""
-    from ar3cli.cache import take_learned
-
     return lint_file(path, rules, options, cache), take_learned()
 
 
-def _result_cache(options: LintOptions, rules: list[Rule]):
+def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None:
     """The result cache for these settings, or None when caching is off or cannot apply (``--sim``)."""
-    from ar3cli.cache import cache_dir
-
     if options.sim or cache_dir() is None:
         return None
     from ar3cli.lint_cache import ResultCache
 
-    settings = repr(([rule.code for rule in rules], sorted(options.per_file_ignores.items()),
-                     sorted((code, level.value) for code, level in options.severity.items()),
-                     sorted((name, os.path.abspath(folder)) for name, folder in options.package_paths.items()),
-                     sorted(options.xacro_args.items())))
-    return ResultCache(settings)
+    return ResultCache.for_settings(rules=[rule.code for rule in rules], per_file_ignores=options.per_file_ignores,
+                                    severity=options.severity, package_paths=options.package_paths,
+                                    xacro_args=options.xacro_args)
 
 
-def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache=None) -> FileResult:
+def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: ResultCache | None = None) -> FileResult:
     """Load one file and run ``rules`` on it; a load failure is a finding, never an exception.
 
     ``cache`` (a :class:`~ar3cli.lint_cache.ResultCache`) answers for unchanged ``.urdf`` files

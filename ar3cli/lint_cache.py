@@ -4,7 +4,7 @@
 checks the same unchanged models again and again. Like ruff, ar3cli keeps each file's findings
 and reuses them while nothing they depend on has changed:
 
-* the file's path (as given, absolute, and with every symlink resolved), the selected rules and
+* the file's path (absolute, with every symlink resolved, and as displayed), the selected rules and
   every option, the ``ROS_PACKAGE_PATH`` / ``AMENT_PREFIX_PATH`` environment, and ar3cli itself
   (version and the size and time of each of its source files), all hashed into the key: one
   entry per file;
@@ -30,7 +30,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ar3cli import __version__
-from ar3cli.cache import PathState, file_facts, path_state
+from ar3cli.cache import MISSING, PathState, file_facts, path_state
 from ar3cli.findings import Finding, Severity
 
 MAX_RESULTS = 2_000
@@ -52,7 +52,7 @@ def code_fingerprint() -> str:
                 if entry.name.endswith(".py"):
                     status = entry.stat()
                     parts.append(f"{entry.path}:{status.st_mtime_ns}:{status.st_size}")
-                elif entry.name not in ("__pycache__", "assets") and entry.is_dir():
+                elif entry.name != "__pycache__" and entry.is_dir():
                     folders.append(entry.path)
     return "\n".join([__version__, sys.version, _lxml_version(), *sorted(parts)])
 
@@ -67,6 +67,17 @@ def _lxml_version() -> str:
 class ResultCache:
     """Remembered findings for one lint run's settings (rules, options, environment)."""
 
+    @classmethod
+    def for_settings(cls, rules: list[str], per_file_ignores: Mapping[str, list[str]],
+                     severity: Mapping[str, Severity], package_paths: Mapping[str, Path],
+                     xacro_args: Mapping[str, str]) -> ResultCache:
+        """The cache for a run with these rule codes and options (package folders made absolute:
+        a relative one means another folder from another working directory)."""
+        return cls(repr((list(rules), sorted(per_file_ignores.items()),
+                         sorted((code, level.value) for code, level in severity.items()),
+                         sorted((name, os.path.abspath(folder)) for name, folder in package_paths.items()),
+                         sorted(xacro_args.items()))))
+
     def __init__(self, settings: str) -> None:
         """``settings``: everything about the run that can change a file's findings, as text."""
         context = [code_fingerprint(), settings, *(f"{name}={os.environ.get(name, '')}" for name in _ENVIRONMENT)]
@@ -74,8 +85,9 @@ class ResultCache:
 
     def _key(self, path: Path, shown: str) -> str:
         """One entry per file and settings: a new version of a file replaces the old one. The path
-        as given, as shown and with every symlink resolved: ``current/robot.urdf`` through a
-        re-pointed ``current`` link, or ``link/../robot.urdf``, is another file."""
+        absolute (normalised as text), with every symlink resolved, and as displayed:
+        ``current/robot.urdf`` through a re-pointed ``current`` link, or ``link/../robot.urdf``,
+        is another file."""
         digest = hashlib.sha256(self._context)
         for part in (os.path.abspath(path), os.path.realpath(path), shown):
             digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
@@ -87,6 +99,8 @@ class ResultCache:
         if content is None:
             return None
         entry = _STORE.lookup(self._key(path, shown))
+        if entry is MISSING:
+            return None
         try:
             if entry["content"] != hashlib.sha256(content).hexdigest():
                 return None

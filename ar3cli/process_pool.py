@@ -11,10 +11,11 @@ safe there) everything runs in this process.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import signal
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import UserError
@@ -43,10 +44,10 @@ def worker_count(requested: int | None, items: int, min_items_per_worker: int) -
     """Processes to use: one per ``min_items_per_worker`` items, at most one per CPU (and
     :data:`MAX_AUTO_WORKERS`), 1 where forking is not available; ``requested`` overrides the rule
     but not the limits of one per item and one per CPU (more would only compete for them)."""
-    if requested is not None:
-        return max(1, min(requested, items, available_cpus()))
     if not can_fork():
         return 1
+    if requested is not None:
+        return max(1, min(requested, items, available_cpus()))
     return max(1, min(available_cpus(), MAX_AUTO_WORKERS, items // min_items_per_worker))
 
 
@@ -63,67 +64,85 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
         return [function(item) for item in items]
     workers = min(workers, len(items))
     children: dict[int, tuple[int, BinaryIO]] = {}  # share number -> (pid, the pipe it answers through)
+    interrupted = False
     try:
         for number in range(1, workers):
-            child = _start_child(function, items[number::workers], [pipe for _, pipe in children.values()])
+            with _sigint_deferred() as mask:  # a Ctrl-C now would lose the new child's pid
+                child = _start_child(function, items[number::workers], [pipe for _, pipe in children.values()], mask)
+                if child is not None:
+                    children[number] = child
             if child is None:
-                break  # this process takes the shares left over
-            children[number] = child
+                break  # the system refuses more processes: this one takes the shares left over
         shares = {number: [function(item) for item in items[number::workers]]
                   for number in range(workers) if number not in children}
         for number, (pid, pipe) in list(children.items()):
             data = _read_and_reap(pid, pipe)
             del children[number]
             shares[number] = _unpack(data, what)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
     finally:
-        _stop(list(children.values()))  # this process failed or was interrupted: stop the others
+        _stop(list(children.values()), settle=interrupted)  # this process failed or was interrupted
     results: list[Result] = [None] * len(items)  # type: ignore[list-item]
     for number, share in shares.items():
         results[number::workers] = share
     return results
 
 
-def _start_child(function: Callable[[Item], Result], share: Sequence[Item],
-                 siblings: list[BinaryIO]) -> tuple[int, BinaryIO] | None:
+@contextlib.contextmanager
+def _sigint_deferred() -> Iterator[set[signal.Signals]]:
+    """SIGINT held back (delivered on leaving); yields the mask to restore in a forked child."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        yield previous
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+
+
+def _start_child(function: Callable[[Item], Result], share: Sequence[Item], siblings: list[BinaryIO],
+                 mask: set[signal.Signals]) -> tuple[int, BinaryIO] | None:
     """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe;
     None when the system refuses a pipe or a process (too many open files or processes). The child
-    closes its copies of the ``siblings``' pipes: only the parent may hold a reader, so a child
-    whose parent died gets EPIPE instead of waiting on a full pipe."""
+    restores the signal ``mask`` and closes its copies of the ``siblings``' pipes: only the parent
+    may hold a reader, so a child whose parent died gets EPIPE instead of waiting on a full pipe."""
+    try:
+        read_end, write_end = os.pipe()
+    except OSError:
+        return None
+    parent = os.getpid()
+    try:
+        pid = os.fork()
+    except OSError:
+        os.close(read_end)
+        os.close(write_end)
+        return None
+    if pid == 0:  # the child: never returns
+        try:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            os.close(read_end)
+            for pipe in siblings:
+                pipe.close()
+            answer = _answer(lambda: [_unless_orphaned(parent, function, item) for item in share])
+            with os.fdopen(write_end, "wb") as pipe:
+                pipe.write(answer)
+        finally:
+            os._exit(0)
+    os.close(write_end)
+    return pid, os.fdopen(read_end, "rb")
+
+
+def _answer(work: Callable[[], list[Result]]) -> bytes:
+    """The pickled outcome of ``work()``: its results, or what went wrong (including results
+    that cannot be pickled, a bug, not a crash)."""
     import pickle
 
-    parent = os.getpid()
-    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})  # no Ctrl-C between fork and bookkeeping
     try:
-        try:
-            read_end, write_end = os.pipe()
-        except OSError:
-            return None
-        try:
-            pid = os.fork()
-        except OSError:
-            os.close(read_end)
-            os.close(write_end)
-            return None
-        if pid == 0:  # the child: never returns
-            try:
-                signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
-                os.close(read_end)
-                for pipe in siblings:
-                    pipe.close()
-                try:
-                    outcome: tuple = ("ok", [_unless_orphaned(parent, function, item) for item in share])
-                except UserError as exc:
-                    outcome = ("user-error", (exc.message, exc.exit_code))
-                except BaseException as exc:  # noqa: BLE001 - reported by the parent
-                    outcome = ("error", f"{type(exc).__name__}: {exc}")
-                with os.fdopen(write_end, "wb") as pipe:
-                    pickle.dump(outcome, pipe, protocol=pickle.HIGHEST_PROTOCOL)
-            finally:
-                os._exit(0)
-        os.close(write_end)
-        return pid, os.fdopen(read_end, "rb")
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+        return pickle.dumps(("ok", work()), protocol=pickle.HIGHEST_PROTOCOL)
+    except UserError as exc:
+        return pickle.dumps(("user-error", (exc.message, exc.exit_code)))
+    except BaseException as exc:  # noqa: BLE001 - reported by the parent
+        return pickle.dumps(("error", f"{type(exc).__name__}: {exc}"))
 
 
 def _unless_orphaned(parent: int, function: Callable[[Item], Result], item: Item) -> Result:
@@ -141,7 +160,7 @@ def _read_and_reap(pid: int, pipe: BinaryIO) -> bytes:
     return data
 
 
-def _unpack(data: bytes, what: str) -> list:
+def _unpack(data: bytes, what: str) -> list[Result]:
     """The child's results; its failure is raised here as it would have been in this process."""
     import pickle
 
@@ -164,20 +183,26 @@ STOP_SECONDS = 3.0
 """A child asked to stop (SIGINT) gets this long before it is killed."""
 
 
-def _stop(children: list[tuple[int, BinaryIO]]) -> None:
-    """End the remaining children: closed pipes, a moment to finish, SIGINT, then SIGKILL."""
-    for _, pipe in children:
-        pipe.close()  # a child still writing its answer gets EPIPE and ends
-    running = {pid for pid, _ in children}
-    for action, seconds in ((None, SETTLE_SECONDS), (signal.SIGINT, STOP_SECONDS), (signal.SIGKILL, None)):
-        for pid in running if action else ():
-            try:
-                os.kill(pid, action)
-            except ProcessLookupError:
-                pass
-        running = _reap(running, seconds)
-        if not running:
-            return
+def _stop(children: list[tuple[int, BinaryIO]], settle: bool) -> None:
+    """End the remaining children: closed pipes, a moment to finish after Ctrl-C (``settle``),
+    SIGINT, then SIGKILL. A second Ctrl-C meanwhile waits until they are gone (a few seconds at
+    most), so none is left running."""
+    if not children:
+        return
+    with _sigint_deferred():
+        for _, pipe in children:
+            pipe.close()  # a child still writing its answer gets EPIPE and ends
+        running = {pid for pid, _ in children}
+        steps = ((None, SETTLE_SECONDS if settle else 0.0), (signal.SIGINT, STOP_SECONDS), (signal.SIGKILL, None))
+        for action, seconds in steps:
+            for pid in running if action else ():
+                try:
+                    os.kill(pid, action)
+                except ProcessLookupError:
+                    pass
+            running = _reap(running, seconds)
+            if not running:
+                return
 
 
 def _reap(pids: set[int], seconds: float | None) -> set[int]:

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ar3cli import lint_cache, model
+from ar3cli import cache, lint_cache, model
 from ar3cli.cache import FileFacts
 from ar3cli.lint import LintOptions, _result_cache, lint_paths
 
@@ -36,7 +36,9 @@ def store(tmp_path, monkeypatch) -> Path:
     folder = tmp_path / "cache"
     monkeypatch.setenv("AR3CLI_CACHE_DIR", str(folder))
     monkeypatch.delenv("AR3CLI_NO_CACHE", raising=False)
-    monkeypatch.setattr(lint_cache, "_STORE", FileFacts("lint-results", version=1))
+    store = FileFacts("lint-results", version=1)
+    monkeypatch.setattr(lint_cache, "_STORE", store)
+    monkeypatch.setitem(cache._OPEN, "lint-results", store)  # what workers' facts merge into
     return folder
 
 
