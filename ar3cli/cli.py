@@ -5,7 +5,6 @@ Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad inp
 ``AR3CLI_DEBUG=1`` to see the traceback).
 """
 
-import errno
 import os
 import sys
 
@@ -82,7 +81,6 @@ def main(argv: list[str] | None = None) -> None:
     usage_error, no_args = _click_exceptions()
     try:
         code = app(args=argv, prog_name="ar3cli", standalone_mode=False)
-        sys.stdout.flush()  # a full disk or a closed pipe is reported here, not at interpreter exit
         if code == 130:  # typer turns Ctrl-C into Exit(130)
             print("ar3cli: interrupted", file=sys.stderr)
         sys.exit(code if isinstance(code, int) else 0)
@@ -103,15 +101,6 @@ def main(argv: list[str] | None = None) -> None:
     except KeyboardInterrupt:
         print("ar3cli: interrupted", file=sys.stderr)
         sys.exit(130)
-    except BrokenPipeError:  # the reader went away (`| head`): nothing more to say to it
-        _discard_stdout()
-        sys.exit(EXIT_USAGE)
-    except OSError as exc:
-        if exc.errno not in (errno.ENOSPC, errno.EDQUOT, errno.EIO):
-            raise
-        _discard_stdout()
-        print(f"ar3cli: error: cannot write the output: {exc.strerror}", file=sys.stderr)
-        sys.exit(EXIT_USAGE)
     except Exception as exc:  # a bug in ar3cli: one line unless debugging
         if os.environ.get("AR3CLI_DEBUG"):
             raise
@@ -134,12 +123,3 @@ def _reopen_closed_standard_streams() -> None:
     if sys.stderr is None:
         sys.stderr = open(os.devnull, "w", encoding="utf-8")  # noqa: SIM115
 
-
-def _discard_stdout() -> None:
-    """Point descriptor 1 at /dev/null, so the text still buffered is dropped quietly at exit."""
-    try:
-        null = os.open(os.devnull, os.O_WRONLY)
-        os.dup2(null, 1)
-        os.close(null)
-    except OSError:
-        pass

@@ -1,8 +1,10 @@
 """The one output layer: every command hands it a :class:`Report` and a format.
 
-Text goes to a rich console: tables with colour on a terminal, plain ASCII tables without colour
-when stdout is not a terminal or ``NO_COLOR`` is set. JSON goes to stdout alone, so
-``ar3cli ... --format json | jq`` always works; progress and logs go to stderr.
+Text goes to a rich console on a terminal (tables with colour, without it when ``NO_COLOR`` is
+set). Off a terminal (pipes, CI logs, pre-commit) tables are plain ASCII, one line per row, and
+rich is not even imported unless the report holds rich renderables. JSON goes to stdout alone, so
+``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing to write
+the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
 Lint's extra formats (sarif, github, markdown) live in their own modules and use the same Report.
 """
 
@@ -14,7 +16,9 @@ import math
 import os
 import sys
 from dataclasses import dataclass, field
-from typing import Any, NoReturn
+from typing import Any, NoReturn, TextIO
+
+from ar3cli.errors import UserError
 
 
 class OutputFormat(str, enum.Enum):
@@ -166,8 +170,26 @@ def render_table(table: Table, out=None) -> None:
 
 def emit_json(data: Any) -> None:
     """Write one JSON document to stdout, and nothing else."""
-    sys.stdout.write(json.dumps(data, indent=2, default=_json_default, allow_nan=False) + "\n")
-    sys.stdout.flush()
+    write(sys.stdout, json.dumps(data, indent=2, default=_json_default, allow_nan=False) + "\n")
+
+
+def write(stream: TextIO, text: str) -> None:
+    """Write and flush ``text``; a full disk or an I/O error becomes a one-line UserError (and
+    the descriptor is pointed at /dev/null, so the text still buffered is dropped quietly at exit).
+    A reader that went away (``| head``) is left to the CLI's usual quiet exit."""
+    try:
+        stream.write(text)
+        stream.flush()
+    except BrokenPipeError:
+        raise
+    except OSError as exc:
+        try:
+            null = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(null, stream.fileno())
+            os.close(null)
+        except (OSError, ValueError):
+            pass
+        raise UserError(f"cannot write the output: {exc.strerror or exc}") from None
 
 
 def _json_default(value: Any) -> Any:
@@ -189,13 +211,12 @@ def render(report: Report, fmt: OutputFormat | str) -> None:
         emit_json(report.data)
         return
     if report.text:
-        sys.stdout.write(report.text)
-        sys.stdout.flush()
+        write(sys.stdout, report.text)
     stream = sys.stderr if report.text else sys.stdout
     if not report.renderables and not stream.isatty():
-        # Pipes, CI logs, pre-commit: plain tables and lines need no rich (importing it costs ~25 ms).
-        stream.write("".join([*map(plain_table, report.tables), *(line + "\n" for line in report.lines)]))
-        stream.flush()
+        # What render_table would print off a terminal, without creating a console: importing rich
+        # costs ~25 ms of every piped run.
+        write(stream, "".join([*map(plain_table, report.tables), *(line + "\n" for line in report.lines)]))
         return
     out = console(stderr=bool(report.text))
     for table in report.tables:

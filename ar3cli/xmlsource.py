@@ -13,6 +13,7 @@ so any ``<!ENTITY`` is refused before parsing. DTDs are not loaded and the netwo
 
 from __future__ import annotations
 
+import os
 import re
 import stat
 from dataclasses import dataclass
@@ -44,24 +45,32 @@ class Quirk:
 
 
 def read_bytes(path: Path) -> bytes:
-    """Return the file's bytes, or raise a one-line :class:`UserError` saying why not."""
+    """Return the file's bytes, or raise a one-line :class:`UserError` saying why not.
+
+    The file is opened without blocking and checked on the open descriptor: a FIFO or a terminal
+    (which would wait forever) is refused even if it replaced a regular file a moment ago.
+    """
     if not path.exists():
         raise UserError(f"{path}: no such file")
     if path.is_dir():
         raise UserError(f"{path}: is a directory, expected a .urdf or .xacro file")
-    status = path.stat()
-    if not stat.S_ISREG(status.st_mode):  # reading a FIFO or a terminal would wait forever
-        raise UserError(f"{path}: not a regular file (a pipe, socket or device); expected a .urdf or .xacro file")
-    size = status.st_size
-    if size > MAX_FILE_BYTES:
-        raise UserError(
-            f"{path}: file is {size / 1e6:.0f} MB, larger than the {MAX_FILE_BYTES // 1024 // 1024} MB limit "
-            "for robot descriptions; is this really a URDF?"
-        )
     try:
-        return path.read_bytes()
+        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
     except OSError as exc:
         raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    with os.fdopen(descriptor, "rb") as handle:
+        status = os.fstat(descriptor)
+        if not stat.S_ISREG(status.st_mode):
+            raise UserError(f"{path}: not a regular file (a pipe, socket or device); expected a .urdf or .xacro file")
+        if status.st_size > MAX_FILE_BYTES:
+            raise UserError(
+                f"{path}: file is {status.st_size / 1e6:.0f} MB, larger than the {MAX_FILE_BYTES // 1024 // 1024} MB "
+                "limit for robot descriptions; is this really a URDF?"
+            )
+        try:
+            return handle.read()
+        except OSError as exc:
+            raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
 
 
 def refuse_entities(data: bytes, path: Path) -> None:

@@ -36,13 +36,13 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 CACHE = Path(tempfile.mkdtemp(prefix="ar3cli-bench-cache-"))
-"""ar3cli's on-disk mesh cache for this run only: "empty cache" runs delete it first."""
+"""ar3cli's on-disk caches (mesh boxes, lint results) for this run only: "nothing cached" runs delete them first."""
 ENV = {**{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"},
        "PYTHONPATH": str(REPO), "NO_COLOR": "1", "AR3CLI_CACHE_DIR": str(CACHE)}
 
 
 def timed(command: list[str], empty_cache: bool = False) -> tuple[float, float]:
-    """(wall, CPU) seconds of one run of ``command`` (with ar3cli's mesh cache emptied first if asked)."""
+    """(wall, CPU) seconds of one run of ``command`` (with ar3cli's caches emptied first if asked)."""
     if empty_cache:
         shutil.rmtree(CACHE, ignore_errors=True)
     before = resource.getrusage(resource.RUSAGE_CHILDREN)

@@ -2,6 +2,10 @@
 
 from __future__ import annotations
 
+import sys
+
+import pytest
+
 
 def test_help_lists_commands(cli):
     result = cli("--help")
@@ -56,6 +60,25 @@ def shell(command: str) -> "subprocess.CompletedProcess[bytes]":
                           env={**os.environ, "PYTHONPATH": str(REPO), "NO_COLOR": "1"}, timeout=300)
 
 
+def test_an_unexpected_os_error_is_one_line_internal_error(monkeypatch, capsys):
+    """Only a failure to write the output is a user error; any other OSError escaping a command is
+    a bug in ar3cli, reported in one line with exit 3 (never a traceback)."""
+    import pytest
+
+    from ar3cli import cli
+
+    def broken(**_kwargs):
+        raise PermissionError(13, "Permission denied", "/somewhere")
+
+    monkeypatch.setattr(cli, "app", broken)
+    monkeypatch.delenv("AR3CLI_DEBUG", raising=False)
+    with pytest.raises(SystemExit) as exit_:
+        cli.main(["lint-urdf", "x.urdf"])
+    (line,) = capsys.readouterr().err.splitlines()
+    assert exit_.value.code == 3 and line.startswith("ar3cli: internal error: PermissionError")
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="uses /dev/full and shell redirections")
 def test_closed_or_full_standard_streams():
     """stderr closed with --sim (pybullet's C output is captured by duplicating descriptors 1 and
     2), stdout closed, stdout on a full disk: clean JSON, an exit code, one line, no traceback."""
