@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+import subprocess
 import sys
 
 import pytest
@@ -48,12 +50,8 @@ def test_help_texts_survive_markdown_rendering():
             assert not bare_tag.search(text), f"ar3cli {name}: help text {text!r} has a bare <tag>"
 
 
-def shell(command: str) -> "subprocess.CompletedProcess[bytes]":
+def shell(command: str) -> subprocess.CompletedProcess[bytes]:
     """Run ``python -m ar3cli COMMAND`` through the shell (for redirections such as ``>&-``)."""
-    import os
-    import subprocess
-    import sys
-
     from tests.conftest import REPO
 
     return subprocess.run(f"{sys.executable} -m ar3cli {command}", shell=True, capture_output=True, cwd=REPO,
