@@ -19,7 +19,6 @@ import atexit
 import contextlib
 import json
 import os
-import stat
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -42,20 +41,6 @@ def path_state(path: str) -> PathState | None:
     except (OSError, ValueError):
         return None
     return status.st_mtime_ns, status.st_ctime_ns, status.st_size, status.st_mode
-
-
-def read_regular_file(path: str) -> bytes | None:
-    """The bytes of ``path`` if it is a regular file, else None. Opened without blocking and
-    checked on the open descriptor, so a FIFO (which would wait for a writer forever) cannot
-    slip in between a check and the read."""
-    try:
-        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError:
-        return None
-    with os.fdopen(descriptor, "rb") as handle:
-        if not stat.S_ISREG(os.fstat(descriptor).st_mode):
-            return None
-        return handle.read()
 
 
 _OPEN: dict[str, FileFacts] = {}
@@ -157,11 +142,13 @@ class FileFacts:
 
 def _read_entries(location: Path) -> dict[str, Any]:
     """The cache file's entries; {} when there is none, or a damaged one (junk, JSON nested
-    thousands deep, a pipe in its place)."""
-    data = read_regular_file(str(location))
+    thousands deep, a pipe in its place: read like a robot file, regular files only)."""
+    from ar3cli.errors import UserError
+    from ar3cli.xmlsource import read_bytes
+
     try:
-        loaded = json.loads(data) if data else {}
-    except (ValueError, RecursionError):
+        loaded = json.loads(read_bytes(location))
+    except (UserError, ValueError, RecursionError):
         return {}
     return loaded if isinstance(loaded, dict) else {}
 

@@ -34,12 +34,13 @@ from ar3cli.cache import MISSING, PathState, file_facts, path_state
 from ar3cli.findings import Finding, Severity
 
 MAX_RESULTS = 2_000
-"""Remembered files; beyond this the oldest half is dropped. Every run reads the whole store
-(0.5 to 2.5 kB a file: pybullet_data's 1101 files make 0.5 MB, read in ~4 ms)."""
+"""Remembered files; beyond this the least recently stored are dropped. Every run reads the whole
+store (0.5 to 2.5 kB a file: pybullet_data's 1101 files make 0.5 MB, read in ~4 ms)."""
 
 _STORE = file_facts("lint-results", version=1, max_entries=MAX_RESULTS)
 _PACKAGE_DIR = Path(__file__).resolve().parent
 _ENVIRONMENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH")
+
 
 def code_fingerprint() -> str:
     """ar3cli's version plus the size and time of each of its source files: an edited rule (or
@@ -95,11 +96,9 @@ class ResultCache:
 
     def get(self, path: Path, shown: str) -> list[Finding] | None:
         """The findings remembered for this file, or None when it must be checked."""
-        content = _read(path)
-        if content is None:
-            return None
         entry = _STORE.lookup(self._key(path, shown))
-        if entry is MISSING:
+        content = _read(path) if entry is not MISSING else None  # a file never seen is not read twice
+        if content is None:
             return None
         try:
             if entry["content"] != hashlib.sha256(content).hexdigest():

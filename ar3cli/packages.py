@@ -141,7 +141,8 @@ class PackageResolver:
             if ancestor.name == name or self._package_name(ancestor) == name:
                 return ancestor, tuple(tried)
             sibling = self._probe(ancestor / name)
-            if sibling.is_dir() and self._package_name(sibling) in (name, None) and (sibling / "package.xml").exists():
+            if sibling.is_dir() and self._package_name(sibling) in (name, None) \
+                    and self.probed[str(sibling / "package.xml")] is not None:  # the manifest exists
                 return sibling, tuple(tried)
         tried.append(f"ancestors of {self.base_dir} named {name} or with package.xml <name>{name}</name>")
         return None, tuple(tried)
