@@ -29,19 +29,20 @@ Everything here follows measured behaviour (``shared/docs/pybullet-facts.md``), 
 
 from __future__ import annotations
 
-import copy
 import itertools
 import math
 import tempfile
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 from ar3cli.capture import capture_fds
 from ar3cli.errors import UserError
+from ar3cli.isolation import report_stage
 from ar3cli.model import ACTUATED_JOINT_TYPES, Joint, Model
 
+Result = TypeVar("Result")
 Pose = tuple[tuple[float, float, float], tuple[float, float, float, float]]
 """(position xyz, quaternion xyzw) in the world frame."""
 
@@ -230,6 +231,12 @@ class Body:
                 frames[joint.link_name] = (tuple(state[4]), tuple(state[5]))  # type: ignore[assignment]
         return frames
 
+    def nonfinite_links(self, frames: Mapping[str, Pose] | None = None) -> list[str]:
+        """Links whose frame (``frames``, default: the current :meth:`link_frames`) holds a NaN or inf."""
+        frames = self.link_frames() if frames is None else frames
+        return [name for name, (position, orientation) in frames.items()
+                if not all(math.isfinite(value) for value in (*position, *orientation))]
+
     def contacts(self, distance: float = 0.0, min_depth: float | None = None) -> list[tuple[str, str, float]]:
         """Self-contacts after a fresh collision pass: (link_a, link_b, deepest signed distance in m).
 
@@ -307,6 +314,7 @@ class Session:
         base_orientation: Iterable[float] = (0.0, 0.0, 0.0, 1.0),
         self_collision: str | None = None,
         maximal_coordinates: bool = False,
+        allow_nan_frames: bool = False,
     ) -> Body:
         """Load ``model`` with explicit flags; raises UserError quoting pybullet's reason on failure.
 
@@ -315,6 +323,9 @@ class Session:
         adds ``URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_INCLUDE_PARENT``.
         ``maximal_coordinates=True`` loads a free object as a plain rigid body instead of a
         multibody (``useMaximalCoordinates``): its contacts are cheaper to solve.
+        A body whose link frames are NaN at the zero configuration (a zero joint axis, say) is
+        refused with a UserError, so that no command computes with NaN; ``allow_nan_frames=True``
+        is for the lint rules that report exactly that.
         """
         p = self.p
         refuse_what_crashes_pybullet(model)
@@ -323,6 +334,7 @@ class Session:
         if self_collision == SELF_COLLISION_ALL_PAIRS:
             flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_INCLUDE_PARENT
         urdf_path = self._write_loadable_copy(model)
+        report_stage("loading it")
         with capture_fds() as captured:
             try:
                 body_id = p.loadURDF(str(urdf_path), list(base_position), list(base_orientation),
@@ -334,6 +346,7 @@ class Session:
         self.messages.extend(messages)
         if body_id < 0:
             raise UserError(f"{model.path}: pybullet cannot load it: {load_failure_reason(model, messages)}")
+        report_stage("simulating it")
         body = Body(self, body_id, model)
         too_many = (f"{len(body.joints)} joints; pybullet cannot report the states of a body with "
                     f"{MAX_PYBULLET_JOINTS} or more (getJointState fails)" if len(body.joints) >= MAX_PYBULLET_JOINTS
@@ -342,28 +355,20 @@ class Session:
         if too_many:
             body.remove()
             raise UserError(f"{model.path}: {too_many}, so no simulation of it can be trusted")
+        broken = [] if allow_nan_frames else body.nonfinite_links()
+        if broken:
+            body.remove()
+            raise UserError(f"{model.path}: pybullet computes non-finite (NaN) frames for {_listing(broken)} at the "
+                            "zero configuration (a zero joint axis or a non-finite number in the file?), so no "
+                            "simulation of it can be trusted; see ar3cli lint-urdf")
         return body
 
     def _write_loadable_copy(self, model: Model) -> Path:
-        """Write the (expanded) document with every mesh/texture filename made absolute.
+        """Write the copy pybullet loads (:mod:`ar3cli.loadable_copy`) under a fresh name."""
+        from ar3cli.loadable_copy import write_loadable_copy
 
-        The copy is indented, one element per line: pybullet's XML parser fails on very long lines
-        (measured: a valid one-line URDF of ~11,000 characters gives XML_ERROR_PARSING_ATTRIBUTE).
-        """
-        from lxml import etree
-
-        root = copy.deepcopy(model.root)
-        etree.indent(root, space=" ")
-        for element in root.iter():
-            uri = element.get("filename")
-            if not uri:
-                continue
-            resolution = model.resolver.resolve(uri)
-            if resolution.found:
-                element.set("filename", str(resolution.path))
-        path = Path(self._tmp.name) / f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
-        path.write_bytes(etree.tostring(root, xml_declaration=True, encoding="utf-8"))
-        return path
+        name = f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
+        return write_loadable_copy(model, Path(self._tmp.name) / name)
 
     def step(self, count: int = 1) -> None:
         for _ in range(count):
@@ -388,6 +393,36 @@ def refuse_what_crashes_pybullet(model: Model) -> None:
         if len(name) > MAX_PYBULLET_NAME:
             raise UserError(f"{model.path}: {kind} name {name[:20]}... is {len(name)} characters long; pybullet "
                             f"crashes on names this long: keep names under {MAX_PYBULLET_NAME} characters")
+
+
+def run_pybullet(work: Callable[[], Result], model: Model) -> Result:
+    """``work()`` (pybullet work on ``model``) in a forked child: a crash in pybullet's C code becomes
+    a one-line :class:`~ar3cli.isolation.CrashError` (exit 2) naming the file, what pybullet was
+    doing, and the element known to cause it, instead of killing ar3cli."""
+    from ar3cli.isolation import run_isolated
+
+    return run_isolated(work, str(model.path), cause=lambda: known_crash_cause(model))
+
+
+def _listing(names: Sequence[str], most: int = 5) -> str:
+    """``link 'a'`` / ``links 'a', 'b' and 3 more``."""
+    shown = ", ".join(f"'{name}'" for name in names[:most])
+    more = f" and {len(names) - most} more" if len(names) > most else ""
+    return f"link{'s' if len(names) > 1 else ''} {shown}{more}"
+
+
+def known_crash_cause(model: Model) -> str | None:
+    """What in ``model`` is known to crash pybullet 3.2.7 (measured), as a phrase naming the element."""
+    parents: dict[str, list[Joint]] = {}
+    for joint in model.joints:
+        if joint.child:
+            parents.setdefault(joint.child, []).append(joint)
+    for link, joints in parents.items():
+        if len(joints) > 1:
+            names = ", ".join(f"'{joint.name}' (line {joint.line})" for joint in joints)
+            return (f"link '{link}' is the child of {len(joints)} joints ({names}), which crashes pybullet: "
+                    "keep one of them")
+    return None
 
 
 def load_failure_reason(model: Model, messages: list[str]) -> str:

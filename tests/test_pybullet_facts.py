@@ -6,10 +6,13 @@ If a pybullet release changes one of them, this file fails and the docs must cha
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
+from ar3cli.isolation import CrashError, run_isolated
 from ar3cli.model import load_model
+from ar3cli.process_pool import can_fork
 from ar3cli.sim import Session
 
 CYLINDER = """<robot name="c"><link name="a"><inertial><mass value="1"/>
@@ -103,3 +106,47 @@ def test_file_caching_serves_stale_content_under_the_same_name(tmp_path):
         finally:
             p.disconnect(physicsClientId=client)
     assert masses == [0.5, 0.5]  # the rewrite is ignored
+
+
+# ---- link order (docs: "Link order matters ...") ------------------------------------------------
+LINK_ORDER = Path(__file__).parent / "data" / "link_order"
+
+
+def _raw_load_nan_links(path: Path, maintain_order: bool) -> list[str]:
+    """Load ``path`` as it is (no ar3cli copy) and list the links whose frame is NaN."""
+    import pybullet as p
+
+    client = p.connect(p.DIRECT)
+    try:
+        flags = p.URDF_USE_INERTIA_FROM_FILE | (p.URDF_MAINTAIN_LINK_ORDER if maintain_order else 0)
+        body = p.loadURDF(str(path), useFixedBase=True, flags=flags, physicsClientId=client)
+        return [p.getJointInfo(body, i, physicsClientId=client)[12].decode()
+                for i in range(p.getNumJoints(body, physicsClientId=client))
+                if any(math.isnan(v) for v in p.getLinkState(body, i, computeForwardKinematics=True,
+                                                             physicsClientId=client)[4])]
+    finally:
+        p.disconnect(physicsClientId=client)
+
+
+@pytest.mark.skipif(not can_fork(), reason="a pybullet crash can only be observed from a forked child")
+@pytest.mark.parametrize("name", ["root_last.urdf", "root_middle.urdf"])
+def test_maintain_link_order_crashes_when_the_root_is_not_first(name):
+    path = LINK_ORDER / name
+    with pytest.raises(CrashError):
+        run_isolated(lambda: _raw_load_nan_links(path, maintain_order=True), name)
+    assert run_isolated(lambda: _raw_load_nan_links(path, maintain_order=False), name) == []
+
+
+@pytest.mark.skipif(not can_fork(), reason="loads in a forked child, in case pybullet crashes")
+def test_maintain_link_order_gives_nan_to_a_link_declared_before_its_parent():
+    path = LINK_ORDER / "child_before_parent.urdf"
+    nan = run_isolated(lambda: _raw_load_nan_links(path, maintain_order=True), path.name)
+    assert set(nan) == {"b1", "l2", "l3", "l4"}
+    assert run_isolated(lambda: _raw_load_nan_links(path, maintain_order=False), path.name) == []
+
+
+@pytest.mark.skipif(not can_fork(), reason="a pybullet crash can only be observed from a forked child")
+def test_a_link_with_two_parents_crashes_pybullet_whatever_the_flags():
+    path = LINK_ORDER / "two_parents.urdf"
+    with pytest.raises(CrashError):
+        run_isolated(lambda: _raw_load_nan_links(path, maintain_order=False), path.name)
