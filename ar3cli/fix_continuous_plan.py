@@ -240,42 +240,50 @@ def _full_turn_to_continuous(document: Document, plan: FixPlan, joint) -> None:
 def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; check each changed joint's limits (and that a target
     beyond a removed fake limit is reached)."""
-    from ar3cli.sim import Session
+    from ar3cli.sim import run_pybullet
 
-    checks = []
     joints = plan.context.get("joints", {})
     if not joints:
         return {"verified": True, "checks": []}
     try:
-        with Session() as session:
-            body = session.load(model)
-            p = session.p
-            records = {record.name: record for record in body.joints}
-            for name, expected in joints.items():
-                record = records.get(name)
-                if record is None:
-                    checks.append(_check(name, "loaded", False, "joint not found in pybullet"))
-                    continue
-                info = p.getJointInfo(body.id, record.index, physicsClientId=session.client)
-                lower, upper = info[8], info[9]
-                if expected["expect"] == "continuous":
-                    checks.append(_check(name, "no position limit", lower > upper,
-                                         f"getJointInfo lower={lower:g} upper={upper:g}"))
-                    old_upper = expected.get("old_upper")
-                    if old_upper is not None and old_upper < FULL_TURN:
-                        target = old_upper + 0.5
-                        reached = _drive(session, body, record.index, target)
-                        checks.append(_check(name, "target beyond old limit", abs(reached - target) < 1e-2,
-                                             f"target {target:.4g} rad, reached {reached:.4g} rad "
-                                             f"(old upper {old_upper:g})"))
-                else:
-                    ok = math.isclose(lower, expected["lower"], abs_tol=1e-9) and math.isclose(
-                        upper, expected["upper"], abs_tol=1e-9)
-                    checks.append(_check(name, f"{expected['expect']} limits", ok,
-                                         f"getJointInfo lower={lower:.9g} upper={upper:.9g}"))
+        checks = run_pybullet(lambda: _checks_in_pybullet(model, joints), model)
     except UserError as exc:
         return {"verified": False, "checks": [], "error": exc.message}
     return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+
+
+def _checks_in_pybullet(model, joints: dict) -> list[dict]:
+    """Each changed joint's limits as pybullet loads them, and a drive past a removed fake limit."""
+    from ar3cli.sim import Session
+
+    checks: list[dict] = []
+    with Session() as session:
+        body = session.load(model)
+        p = session.p
+        records = {record.name: record for record in body.joints}
+        for name, expected in joints.items():
+            record = records.get(name)
+            if record is None:
+                checks.append(_check(name, "loaded", False, "joint not found in pybullet"))
+                continue
+            info = p.getJointInfo(body.id, record.index, physicsClientId=session.client)
+            lower, upper = info[8], info[9]
+            if expected["expect"] == "continuous":
+                checks.append(_check(name, "no position limit", lower > upper,
+                                     f"getJointInfo lower={lower:g} upper={upper:g}"))
+                old_upper = expected.get("old_upper")
+                if old_upper is not None and old_upper < FULL_TURN:
+                    target = old_upper + 0.5
+                    reached = _drive(session, body, record.index, target)
+                    checks.append(_check(name, "target beyond old limit", abs(reached - target) < 1e-2,
+                                         f"target {target:.4g} rad, reached {reached:.4g} rad "
+                                         f"(old upper {old_upper:g})"))
+            else:
+                ok = math.isclose(lower, expected["lower"], abs_tol=1e-9) and math.isclose(
+                    upper, expected["upper"], abs_tol=1e-9)
+                checks.append(_check(name, f"{expected['expect']} limits", ok,
+                                     f"getJointInfo lower={lower:.9g} upper={upper:.9g}"))
+    return checks
 
 
 def _check(joint: str, check: str, ok: bool, detail: str) -> dict:

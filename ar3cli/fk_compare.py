@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from ar3cli import kinematics
+from ar3cli.errors import UserError
 from ar3cli.model import Model
 
 
@@ -87,9 +88,13 @@ def body_configurations(body, samples: Samples) -> np.ndarray:
 def pybullet_frames(body, samples: Samples) -> dict[str, np.ndarray]:
     """(N, 4, 4) world link frames per link from pybullet, every joint (mimic ones too) set explicitly."""
     poses = []
-    for q in body_configurations(body, samples):
+    for number, q in enumerate(body_configurations(body, samples)):
         body.set_positions(q)
         frames = body.link_frames()
+        broken = body.nonfinite_links(frames)
+        if broken:
+            raise UserError(f"{body.model.path}: pybullet computes non-finite (NaN) frames for "
+                            f"{', '.join(broken)} in sample {number} (seed {samples.seed}); no comparison is possible")
         poses.append([frames[link] for link in body.link_names])
     return frames_from_poses(body.link_names, poses)
 

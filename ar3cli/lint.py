@@ -53,14 +53,16 @@ class LintOptions:
 
 @dataclass
 class FileResult:
-    """One linted file: its display path, whether it loaded, and its findings."""
+    """One linted file: its display path, whether it loaded, its findings, and the one-line error
+    that cut its check short (pybullet crashed on it under ``--sim``), if any."""
 
     path: str
     loaded: bool
     findings: list[Finding]
+    error: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings)}
+        return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
 
 
 class Context:
@@ -212,7 +214,29 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
 
 
 def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> FileResult:
-    """Run ``rules`` on a loaded model and apply suppressions and severity overrides."""
+    """Run ``rules`` on a loaded model and apply suppressions and severity overrides.
+
+    The simulation rules run in a forked child (:func:`~ar3cli.isolation.run_isolated`): when
+    pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
+    """
+    static = [rule for rule in rules if not rule.needs_sim]
+    simulated = [rule for rule in rules if rule.needs_sim]
+    findings = _run_rules(model, shown, static, options)
+    error = None
+    if simulated:
+        from ar3cli.isolation import CrashError
+        from ar3cli.sim import run_pybullet
+
+        try:
+            findings += run_pybullet(lambda: _run_rules(model, shown, simulated, options), model)
+        except CrashError as exc:
+            error = exc.message
+    findings.sort(key=lambda f: (f.line, f.column, f.rule))
+    return FileResult(shown, True, findings, error)
+
+
+def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
+    """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
     context = Context(model, options)
     locator = Locator(model)
     file_ignores = _file_level_ignores(model.source_bytes)
@@ -231,8 +255,7 @@ def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> F
                                                   hit.hint or rule.fix), options))
     finally:
         context.close()
-    findings.sort(key=lambda f: (f.line, f.column, f.rule))
-    return FileResult(shown, True, findings)
+    return findings
 
 
 def load_failure(path: Path, shown: str, message: str) -> Finding:
@@ -342,5 +365,7 @@ def summarize(results: list[FileResult], fail_on: Severity) -> dict[str, Any]:
     findings = [f for r in results for f in r.findings]
     counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}
     return {"files": len(results), "files_with_findings": sum(bool(r.findings) for r in results),
+            "files_with_errors": sum(r.error is not None for r in results),
+            "files_clean": sum(not r.findings and r.error is None for r in results),
             "findings": len(findings), **counts, "fail_on": fail_on.value,
             "failed": any(f.severity >= fail_on for f in findings)}

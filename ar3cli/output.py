@@ -18,7 +18,7 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, NoReturn, TextIO
 
-from ar3cli.errors import UserError
+from ar3cli.errors import EXIT_USAGE, UserError
 
 
 class OutputFormat(str, enum.Enum):
@@ -62,6 +62,9 @@ class Report:
     text: str = ""
     """A verbatim payload for stdout (a unified diff, workflow annotations, Markdown). When set, text
     mode writes it to stdout alone and moves tables and lines to stderr, so the payload can be piped."""
+    errors: list[str] = field(default_factory=list)
+    """One-line errors about part of the work (a file whose pybullet run crashed) while the rest was
+    reported: written to stderr as ``ar3cli: error: ...`` in every format, and the exit code is 2."""
 
 
 def console(stderr: bool = False):
@@ -231,11 +234,14 @@ def render(report: Report, fmt: OutputFormat | str) -> None:
 
 
 def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:
-    """Render ``report`` and end the command: exit 0 when ``report.ok``, else 1 (problems found)."""
+    """Render ``report`` and end the command: exit 2 when it carries :attr:`Report.errors`, else 0
+    when ``report.ok``, else 1 (problems found)."""
     import typer
 
     render(report, fmt)
-    raise typer.Exit(0 if report.ok else 1)
+    for error in report.errors:
+        write(sys.stderr, f"ar3cli: error: {error}\n")
+    raise typer.Exit(EXIT_USAGE if report.errors else 0 if report.ok else 1)
 
 
 def log(message: str) -> None:

@@ -67,7 +67,7 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
     interrupted = False
     try:
         for number in range(1, workers):
-            with _sigint_deferred() as mask:  # a Ctrl-C now would lose the new child's pid
+            with sigint_deferred() as mask:  # a Ctrl-C now would lose the new child's pid
                 child = _start_child(function, items[number::workers], [pipe for _, pipe in children.values()], mask)
                 if child is not None:
                     children[number] = child
@@ -83,7 +83,7 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
         interrupted = True
         raise
     finally:
-        _stop(list(children.values()), settle=interrupted)  # this process failed or was interrupted
+        stop_children(list(children.values()), settle=interrupted)  # this process failed or was interrupted
     results: list[Result] = [None] * len(items)  # type: ignore[list-item]
     for number, share in shares.items():
         results[number::workers] = share
@@ -91,7 +91,7 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
 
 
 @contextlib.contextmanager
-def _sigint_deferred() -> Iterator[set[signal.Signals]]:
+def sigint_deferred() -> Iterator[set[signal.Signals]]:
     """SIGINT held back (delivered on leaving); yields the mask to restore in a forked child."""
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
@@ -183,13 +183,13 @@ STOP_SECONDS = 3.0
 """A child asked to stop (SIGINT) gets this long before it is killed."""
 
 
-def _stop(children: list[tuple[int, BinaryIO]], settle: bool) -> None:
+def stop_children(children: list[tuple[int, BinaryIO]], settle: bool) -> None:
     """End the remaining children: closed pipes, a moment to finish after Ctrl-C (``settle``),
     SIGINT, then SIGKILL. A second Ctrl-C meanwhile waits until they are gone (a few seconds at
     most), so none is left running."""
     if not children:
         return
-    with _sigint_deferred():
+    with sigint_deferred():
         for _, pipe in children:
             pipe.close()  # a child still writing its answer gets EPIPE and ends
         running = {pid for pid, _ in children}

@@ -15,6 +15,7 @@ import io
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 from pathlib import Path
 
 from ar3cli.atomic import atomic_write
@@ -84,32 +85,53 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
     """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``."""
     from PIL import Image
 
-    from ar3cli.adjacency import nonadjacent_collisions
-    from ar3cli.sim import SELF_COLLISION_ALL_PAIRS, Session
+    from ar3cli.sim import run_pybullet
 
     if not 16 <= width <= 4096 or not 16 <= height <= 4096:
         raise UserError(f"image size {width}x{height} is out of range (16..4096 pixels per side)")
     if not output.parent.is_dir():
         raise UserError(f"-o {output}: folder {output.parent} does not exist")
+    rgb, values, contacts = run_pybullet(
+        lambda: _draw(model, configuration or {}, width, height, yaw_deg, pitch_deg, show_collision, show_contacts),
+        model)
+    if picture_is_empty(rgb):
+        raise UserError(f"{model.path}: the picture shows no robot: " + (
+            "no link has <collision> geometry to draw" if show_collision else
+            "no link has <visual> geometry that pybullet draws (try --collision)"))
+    buffer = io.BytesIO()
+    Image.fromarray(rgb).save(buffer, format="PNG")
+    atomic_write(output, buffer.getvalue())
+    return RenderResult(output, width, height, values, contacts)
+
+
+def _draw(model: Model, configuration: Mapping[str, float], width: int, height: int, yaw_deg: float,
+          pitch_deg: float, show_collision: bool, show_contacts: bool) -> tuple[Any, dict[str, float], list]:
+    """In pybullet: the RGB picture, the joint values drawn, and the links in contact (drawn red)."""
+    from ar3cli.adjacency import nonadjacent_collisions
+    from ar3cli.isolation import report_stage
+    from ar3cli.sim import SELF_COLLISION_ALL_PAIRS, Session
+
     with Session() as session:
         drawn = showing_collision_geometry(model) if show_collision else model
         body = session.load(drawn, self_collision=SELF_COLLISION_ALL_PAIRS)
         joints = {joint.name: joint for joint in body.movable_joints}
-        unknown = sorted(set(configuration or {}) - set(joints))
+        unknown = sorted(set(configuration) - set(joints))
         if unknown:
             raise UserError(f"--config names unknown joints: {', '.join(unknown)} "
                             f"(movable joints: {', '.join(joints) or 'none'})")
-        values = configuration_with_mimics(body, configuration or {})
+        values = configuration_with_mimics(body, configuration)
         body.set_positions(values)
         contacts = nonadjacent_collisions(body, model) if show_contacts else []
         for link_name in {name for a, b, _ in contacts for name in (a, b)}:
             session.p.changeVisualShape(body.id, body.link_index[link_name], rgbaColor=CONTACT_RGBA,
                                         physicsClientId=session.client)
-        rgb = _snapshot(session, body, width, height, yaw_deg, pitch_deg)
-    buffer = io.BytesIO()
-    Image.fromarray(rgb).save(buffer, format="PNG")
-    atomic_write(output, buffer.getvalue())
-    return RenderResult(output, width, height, values, contacts)
+        report_stage("rendering it")
+        return _snapshot(session, body, width, height, yaw_deg, pitch_deg), values, contacts
+
+
+def picture_is_empty(rgb) -> bool:
+    """True when every pixel has the background's colour: pybullet drew nothing of the robot."""
+    return bool((rgb == rgb[0, 0]).all())
 
 
 def configuration_with_mimics(body, configuration: Mapping[str, float]) -> dict[str, float]:

@@ -40,18 +40,22 @@ def fk_verify(
 
     from ar3cli import dh as dh_module
     from ar3cli import fk_compare
-    from ar3cli.sim import Session
+    from ar3cli.sim import Session, run_pybullet
 
     if not (tolerance_m > 0 and tolerance_rad > 0):
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
     model = load_from_options(path, package_path, xacro_arg)
     table = dh_module.load_dh(dh, model) if dh is not None else None
-    with Session() as session:
-        body = session.load(model, fixed_base=True)
-        drawn = fk_compare.sample_configurations(model, body, samples, seed)
-        if format is OutputFormat.text:
-            log(f"fk-verify: {samples} samples, seed {seed}")
-        comparison = fk_compare.compare(model, body, drawn)
+
+    def measure() -> tuple[fk_compare.Samples, fk_compare.Comparison]:
+        with Session() as session:
+            body = session.load(model, fixed_base=True)
+            drawn = fk_compare.sample_configurations(model, body, samples, seed)
+            if format is OutputFormat.text:
+                log(f"fk-verify: {samples} samples, seed {seed}")
+            return drawn, fk_compare.compare(model, body, drawn)
+
+    drawn, comparison = run_pybullet(measure, model)
 
     links_ok = all(e.max_position <= tolerance_m and e.max_orientation <= tolerance_rad for e in comparison.links)
     worst = max(comparison.links, key=lambda e: max(e.max_position / tolerance_m, e.max_orientation / tolerance_rad))

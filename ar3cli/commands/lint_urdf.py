@@ -89,6 +89,7 @@ def lint_urdf(
     summary = summarize(results, threshold)
     report = render_lint(results, summary, options, LintFormat(format))
     report.ok = report.ok or exit_zero
+    report.errors = [result.error for result in results if result.error]
     finish(report, "json" if LintFormat(format) in (LintFormat.json, LintFormat.sarif) else "text")
 
 
@@ -98,10 +99,13 @@ def _split(items: list[str] | None) -> list[str]:
 
 def summary_line(summary: dict) -> str:
     files = summary["files"]
-    clean = files - summary["files_with_findings"]
-    verdict = "FAILED" if summary["failed"] else "passed"
+    broken = summary["files_with_errors"]
+    clean = summary["files_clean"]
+    verdict = "FAILED" if summary["failed"] or broken else "passed"
+    unchecked = f"; {broken} not fully checked (pybullet crashed)" if broken else ""
     return (f"{verdict}: {files} file{'s' if files != 1 else ''} checked, {summary['error']} errors, "
-            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean (fail-on: {summary['fail_on']})")
+            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{unchecked} "
+            f"(fail-on: {summary['fail_on']})")
 
 
 def render_lint(results, summary: dict, options, fmt: LintFormat) -> Report:

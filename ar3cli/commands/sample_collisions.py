@@ -52,15 +52,19 @@ def sample_collisions(
     from ar3cli.adjacency import collision_links
     from ar3cli.adjacency import adjacent_pairs
     from ar3cli.collisions import Checker
+    from ar3cli.sim import run_pybullet
 
     _check_outputs(srdf, pybullet_filter, png)
     model = _load(path, package_path, xacro_arg)
     if len(collision_links(model)) < 2:
         raise UserError(_no_pairs_message(model))
     source = _source(model, package_path, xacro_arg)
-    with Checker(model) as checker:
-        run = _run(checker, source, samples, seed, jobs)
-    links, pairs = checker.links, checker.pairs
+
+    def measure() -> tuple[list[str], list, dict]:
+        with Checker(model) as checker:
+            return checker.links, checker.pairs, _run(checker, source, samples, seed, jobs)
+
+    links, pairs, run = run_pybullet(measure, model)
     adjacent = adjacent_pairs(model, links)
     results = cm.classify(links, pairs, run["counts"], samples, adjacent, run["home_hits"], run["limit_hits"],
                           always_threshold)

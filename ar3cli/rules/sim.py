@@ -26,7 +26,7 @@ def _loaded(ctx, **load_options):
     """Load the model into the file's session and remove it afterwards; yields None when it fails."""
     session = ctx.session
     try:
-        body = session.load(ctx.model, **load_options)
+        body = session.load(ctx.model, allow_nan_frames=True, **load_options)
     except UserError:
         yield None
         return
@@ -50,7 +50,7 @@ def _home(body) -> dict[str, float]:
       bad=arm(joint_extra=""), good=arm(), needs_sim=True)
 def sim_load_failed(ctx) -> Iterator[Hit]:
     try:
-        body = ctx.session.load(ctx.model)
+        body = ctx.session.load(ctx.model, allow_nan_frames=True)
     except UserError as exc:
         yield Hit(exc.message.removeprefix(f"{ctx.model.path}: "), ctx.model.root)
         return

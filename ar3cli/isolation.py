@@ -1,0 +1,185 @@
+"""Run pybullet work in a forked child, so that a crash in C is a message, not the end of ar3cli.
+
+pybullet is C code; on inputs nobody tested it can die by SIGSEGV or SIGABRT, which Python cannot
+catch (``docs/pybullet-facts.md``, section 10). :func:`run_isolated` forks (about a millisecond on
+Linux, with everything already imported), runs the work in the child and pickles its answer back
+through a pipe. When the child dies instead, the caller gets a one-line :class:`CrashError`
+naming the signal and what pybullet was doing then (:func:`report_stage`, which the child calls
+as it goes: "loading it", "rendering it", ...).
+
+Temporary files: a process killed by a signal runs no ``finally`` and no ``atexit``, so the child
+makes its temporary files in a folder this process created, and this process removes it
+whatever happened. Where fork is not available (Windows, macOS), the work runs in this process.
+"""
+
+from __future__ import annotations
+
+import os
+import pickle
+import shutil
+import signal
+import sys
+import tempfile
+from collections.abc import Callable
+from typing import BinaryIO, TypeVar
+
+from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.process_pool import can_fork, sigint_deferred, stop_children
+
+Result = TypeVar("Result")
+
+DEFAULT_STAGE = "running it"
+_stage_pipe: BinaryIO | None = None
+"""In an isolated child: where :func:`report_stage` writes. None everywhere else."""
+
+
+class CrashError(UserError):
+    """The isolated child died (a signal, or an exit without an answer); exit code 2."""
+
+    def __init__(self, message: str, signal_name: str, stage: str) -> None:
+        super().__init__(message, EXIT_USAGE)
+        self.signal_name = signal_name
+        self.stage = stage
+
+
+def report_stage(stage: str) -> None:
+    """Tell the parent what the child is about to do (quoted if the child dies); a no-op elsewhere."""
+    if _stage_pipe is not None:
+        _send(_stage_pipe, ("stage", stage))
+
+
+def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], str | None] | None = None) -> Result:
+    """``work()`` in a forked child; its result (which must pickle) or its exception comes back.
+
+    A UserError in the child is raised here as it was; any other exception becomes a RuntimeError
+    (an internal error); a child that dies raises :class:`CrashError`, e.g.
+    ``ur5.urdf: pybullet crashed (SIGSEGV) while loading it``, ``subject`` being the file, followed
+    by what ``cause()`` says is the likely reason (asked only after a crash), if anything.
+    Ctrl-C stops the child (it gets a moment to finish, then SIGINT, then SIGKILL).
+    """
+    if not can_fork():
+        return work()
+    folder = tempfile.mkdtemp(prefix="ar3cli-")
+    child: tuple[int, BinaryIO] | None = None
+    interrupted = False
+    try:
+        with sigint_deferred() as mask:  # a Ctrl-C between fork and bookkeeping would lose the child
+            child = _start(work, folder, mask)
+        answer, stage = _collect(child[1])
+        status = _reap(child[0])
+        child = None
+        return _unpack(answer, stage, status, subject, cause)
+    except KeyboardInterrupt:
+        interrupted = True
+        raise
+    finally:
+        if child is not None:
+            stop_children([child], settle=interrupted)
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def _start(work: Callable[[], Result], folder: str, mask: set[signal.Signals]) -> tuple[int, BinaryIO]:
+    """Fork the child that runs ``work`` with its temporary files in ``folder``."""
+    for stream in (sys.stdout, sys.stderr):
+        stream.flush()  # what is buffered now must not be written twice
+    read_end, write_end = os.pipe()
+    try:
+        pid = os.fork()
+    except OSError as exc:
+        os.close(read_end)
+        os.close(write_end)
+        raise UserError(f"cannot start a process for pybullet: {exc.strerror or exc}") from None
+    if pid == 0:  # the child: never returns
+        try:
+            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            os.close(read_end)
+            _run_child(work, folder, os.fdopen(write_end, "wb"))
+        finally:
+            os._exit(0)
+    os.close(write_end)
+    return pid, os.fdopen(read_end, "rb")
+
+
+def _run_child(work: Callable[[], Result], folder: str, pipe: BinaryIO) -> None:
+    """The child's whole life: run ``work``, send its outcome, flush what it printed."""
+    global _stage_pipe
+    import faulthandler
+
+    faulthandler.disable()  # a crash is reported by the parent in one line, not as a stack dump
+    tempfile.tempdir = folder
+    _stage_pipe = pipe
+    try:
+        outcome = ("ok", work())
+    except UserError as exc:
+        outcome = ("user-error", (exc.message, exc.exit_code))
+    except KeyboardInterrupt:
+        outcome = ("interrupted", None)
+    except BaseException as exc:  # noqa: BLE001 - reported by the parent as an internal error
+        outcome = ("error", f"{type(exc).__name__}: {exc}")
+    try:
+        _send(pipe, outcome)
+    except Exception as exc:  # noqa: BLE001 - e.g. a result that cannot be pickled: a bug
+        _send(pipe, ("error", f"cannot send the result back: {type(exc).__name__}: {exc}"))
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except Exception:  # noqa: BLE001 - a closed stream must not turn into a crash report
+            pass
+    pipe.close()
+
+
+def _send(pipe: BinaryIO, message: tuple) -> None:
+    pipe.write(pickle.dumps(message, protocol=pickle.HIGHEST_PROTOCOL))
+    pipe.flush()
+
+
+def _collect(pipe: BinaryIO) -> tuple[tuple | None, str]:
+    """Read the child's messages to the end: (its final answer or None, the last stage it named)."""
+    stage, answer = DEFAULT_STAGE, None
+    with pipe:
+        while True:
+            try:
+                kind, payload = pickle.load(pipe)
+            except (EOFError, pickle.UnpicklingError, ValueError, TypeError):
+                break  # the end, or a message cut short by the child's death
+            if kind == "stage":
+                stage = payload
+            else:
+                answer = (kind, payload)
+    return answer, stage
+
+
+def _reap(pid: int) -> int:
+    """Wait for the child; its wait status."""
+    while True:
+        try:
+            return os.waitpid(pid, 0)[1]
+        except InterruptedError:  # pragma: no cover - retried by Python itself since 3.5
+            continue
+        except ChildProcessError:
+            return 0
+
+
+def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
+            cause: Callable[[], str | None] | None) -> Result:
+    if answer is not None:
+        kind, payload = answer
+        if kind == "ok":
+            return payload
+        if kind == "user-error":
+            raise UserError(*payload)
+        if kind == "interrupted":
+            raise KeyboardInterrupt
+        raise RuntimeError(payload)
+    code = os.waitstatus_to_exitcode(status)
+    if code < 0:
+        try:
+            name = signal.Signals(-code).name
+        except ValueError:
+            name = f"signal {-code}"
+    else:
+        name = f"exit {code}"
+    reason = cause() if cause is not None else None
+    explanation = (f"; {reason}" if reason else
+                   f": a bug in pybullet's C code that this file triggers (see 'ar3cli lint-urdf {subject}')")
+    raise CrashError(f"{subject}: pybullet crashed ({name}) while {stage}{explanation}", name, stage)
