@@ -1,5 +1,11 @@
 """The fix-inertia fixer: choose links, pick each link's mass source, write new ``<inertial>``s.
 
+Which links, by default: those the lint inertia rules flag as **invalid** (no ``<inertial>``,
+mass <= 0, tensor not positive definite, A + B < C, all-zero tensor). A link flagged only as
+**implausible** (I007: a valid tensor too large for the geometry) is often a hand-tuned value or a
+deliberate placeholder; it is left alone and reported, unless ``--include-implausible`` (or a
+``--mass`` for that link) asks for it. ``--links`` and ``--all`` choose by hand.
+
 Mass source, always explicit (first that applies): ``--mass LINK=KG``; a valid (finite, > 0)
 mass already in the file; ``--density``; ``--total-mass`` (the robot's total: the masses kept
 above are subtracted and the rest is spread over the remaining links in proportion to their
@@ -14,7 +20,7 @@ PyBullet measurement behind that choice.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
@@ -23,8 +29,12 @@ from ar3cli import mass_properties as mp
 from ar3cli.edits import Document
 from ar3cli.errors import UserError
 from ar3cli.fixing import Change, FixPlan, Skipped, number
+from ar3cli.rules.inertia import inertia_implausible
 
 TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
+IMPLAUSIBLE_CODES = frozenset({inertia_implausible.code})
+"""Lint codes that flag a valid but implausible ``<inertial>``: recomputed only on request."""
+INCLUDE_IMPLAUSIBLE = "--include-implausible"
 
 
 @dataclass
@@ -34,6 +44,18 @@ class InertiaOptions:
     density: float | None = None
     masses: dict[str, float] = field(default_factory=dict)
     total_mass: float | None = None
+    include_implausible: bool = False
+
+
+@dataclass
+class LeftAlone:
+    """A flagged link the default selection does not touch (valid but implausible inertia)."""
+
+    link: str
+    element: str
+    line: int
+    code: str
+    reason: str
 
 
 @dataclass
@@ -69,21 +91,43 @@ def make_fixer(options: InertiaOptions):
     return fix
 
 
-def _select(model, options: InertiaOptions) -> dict[str, str]:
+def _select(model, options: InertiaOptions) -> tuple[dict[str, str], list[LeftAlone]]:
+    """``({link: why it is recomputed}, [flagged links left alone])``."""
     for name in [*(options.links or []), *options.masses]:
         if model.link(name) is None:
             raise UserError(f"{model.path}: no link named {name!r}")
     if options.all_links:
-        return {link.name: "--all" for link in model.links}
+        return {link.name: "--all" for link in model.links}, []
     if options.links:
-        return {name: "--links" for name in options.links}
-    return inertia.links_needing_inertia(model)
+        return {name: "--links" for name in options.links}, []
+    selected: dict[str, str] = {}
+    left_alone: list[LeftAlone] = []
+    for name, reason in inertia.links_needing_inertia(model).items():
+        # One reason per link, from the first rule that flags it; I007 runs last, so a link whose
+        # reason is I007 has nothing invalid (an invalid one would have been reported first).
+        code = reason.split(" ", 1)[0]
+        if code in IMPLAUSIBLE_CODES and not options.include_implausible and name not in options.masses:
+            link = model.link(name)
+            left_alone.append(LeftAlone(name, _element(link), link.line, code, reason))
+        else:
+            selected[name] = reason
+    return selected, left_alone
+
+
+def _left_alone_note(left_alone: list[LeftAlone]) -> str:
+    names = ", ".join(item.link for item in left_alone)
+    codes = ", ".join(sorted({item.code for item in left_alone}))
+    return (f"left {len(left_alone)} link(s) with valid but implausible inertia alone ({codes}): {names}; "
+            f"add {INCLUDE_IMPLAUSIBLE} to recompute them")
 
 
 def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
     plan = FixPlan()
     cache: dict = {}
-    selected = _select(model, options)
+    selected, left_alone = _select(model, options)
+    if left_alone:
+        plan.notes.append(_left_alone_note(left_alone))
+        plan.data["left_alone"] = [asdict(item) for item in left_alone]
     targets: list[_Target] = []
     for name, reason in selected.items():
         link = model.link(name)

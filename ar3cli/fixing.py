@@ -52,6 +52,8 @@ class FixPlan:
     skipped: list[Skipped] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     context: dict[str, Any] = field(default_factory=dict)
+    data: dict[str, Any] = field(default_factory=dict)
+    """Extra per-file fields for the JSON output (e.g. fix-inertia's ``left_alone``)."""
 
 
 Fixer = Callable[[Any, Document], FixPlan]
@@ -71,7 +73,8 @@ class FileResult:
         data = {"path": str(self.path), "changed": self.changed,
                 "written": str(self.written) if self.written else None,
                 "changes": [asdict(c) for c in self.plan.changes],
-                "skipped": [asdict(s) for s in self.plan.skipped], "notes": self.plan.notes}
+                "skipped": [asdict(s) for s in self.plan.skipped], "notes": self.plan.notes,
+                **self.plan.data}
         if self.verification is not None:
             data["verification"] = self.verification
         if self.diff:

@@ -234,14 +234,15 @@ def test_panda_removed_inertial_and_placeholder_tensors(cli, tmp_path, pybullet_
     path = _pybullet_copy(tmp_path, pybullet_data_dir / "franka_panda" / "panda.urdf")
     original = path.read_text()
     write(path, remove_inertial(original, "panda_link5"))
-    result = cli("fix-inertia", str(path), "--mass", "panda_link5=3.0")
+    # The placeholder tensors are valid but implausible (I007): recomputed only on request.
+    result = cli("fix-inertia", str(path), "--mass", "panda_link5=3.0", "--include-implausible")
     assert result.code == 0, result.stdout + result.stderr
     assert [f for f in lint_findings(cli, path, "I") if f["severity"] != "info"] == []
     mass, com, tensor = inertial_of(path, "panda_link5")
     assert mass == 3.0 and mp.is_positive_definite(tensor) and mp.satisfies_triangle_inequality(tensor)
     assert 0.01 < np.linalg.norm(com) < 0.2  # the link5 mesh hangs 0.0-0.26 m below its frame
     assert not any("No inertial data" in m for m in _load_clean_in_pybullet(path))
-    assert cli("fix-inertia", str(path), "--check").code == 0
+    assert cli("fix-inertia", str(path), "--check", "--include-implausible").code == 0
 
 
 def test_real_ar3_meshes_at_cad_density_give_the_cad_masses(cli, tmp_path, shared_dir):
@@ -326,3 +327,95 @@ def test_degenerate_primitives_are_skipped_with_a_reason(cli, write_urdf, geomet
     (skipped,) = json.loads(result.stdout)["files"][0]["skipped"]
     assert "is not usable" in skipped["reason"]
     assert path.read_bytes() == before and "internal error" not in result.stderr
+
+
+PLACEHOLDER = """<?xml version="1.0"?>
+<robot name="placeholder">
+  <link name="base"/>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="bare"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="bare">
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+  </link>
+  <joint name="j2" type="revolute"><parent link="bare"/><child link="tuned"/>
+    <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+  <link name="tuned">
+    <!-- hand-tuned for the controller: keep -->
+    <inertial><mass value="0.1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>
+  </link>
+</robot>
+"""
+LEFT_ALONE = ("left 1 link(s) with valid but implausible inertia alone (I007): tuned; "
+              "add --include-implausible to recompute them")
+
+
+def _link_text(text: str, link: str) -> str:
+    start = text.index(f'<link name="{link}">')
+    return text[start:text.index("</link>", start)]
+
+
+def test_default_fixes_invalid_links_and_leaves_implausible_ones_alone(cli, write_urdf):
+    """bare has no <inertial> (I001, invalid); tuned's I = 1 on 0.1 kg is valid but 37x too wide for
+    its 10 cm box (I007): by default only bare is written, tuned stays byte for byte."""
+    path = write_urdf(PLACEHOLDER)
+    codes = {name: reason.split()[0] for name, reason in links_needing_inertia(load_model(path)).items()}
+    assert codes == {"bare": "I001", "tuned": "I007"}
+    result = cli("fix-inertia", str(path), "--density", "1000")
+    assert result.code == 0, result.stdout + result.stderr
+    assert LEFT_ALONE in result.stdout and "3 field(s) changed" in result.stdout
+    fixed = path.read_text()
+    assert _link_text(fixed, "tuned") == _link_text(PLACEHOLDER, "tuned")
+    assert only_within(PLACEHOLDER, fixed, [element_lines(PLACEHOLDER, r'<link name="bare"', "</link>")])
+    assert inertial_of(path, "bare")[0] == pytest.approx(1.0, rel=1e-12)  # 0.001 m3 x 1000 kg/m3
+    # What is left alone does not make --check fail; JSON carries the same note.
+    check = cli("fix-inertia", str(path), "--check", "--format", "json")
+    assert check.code == 0, check.stdout + check.stderr
+    doc = json.loads(check.stdout)
+    assert doc["ok"] and doc["files"][0]["changes"] == [] and doc["files"][0]["skipped"] == []
+    assert doc["files"][0]["notes"] == [LEFT_ALONE]
+    (tuned,) = doc["files"][0]["left_alone"]
+    assert tuned["link"] == "tuned" and tuned["code"] == "I007" and "radius of gyration" in tuned["reason"]
+    text = cli("fix-inertia", str(path), "--check")
+    assert text.code == 0 and LEFT_ALONE in text.stdout and "nothing to change" in text.stdout
+    assert path.read_text() == fixed
+
+
+def test_include_implausible_recomputes_them_too(cli, write_urdf):
+    path = write_urdf(PLACEHOLDER)
+    check = cli("fix-inertia", str(path), "--density", "1000", "--include-implausible", "--check",
+                "--format", "json")
+    assert check.code == 1
+    (file,) = json.loads(check.stdout)["files"]
+    assert {c["element"] for c in file["changes"]} == {"link bare <inertial>", "link tuned <inertial>"}
+    assert file["notes"] == [] and "left_alone" not in file
+    result = cli("fix-inertia", str(path), "--density", "1000", "--include-implausible")
+    assert result.code == 0, result.stdout + result.stderr
+    assert "inertia alone" not in result.stdout and "4 field(s) changed" in result.stdout
+    mass, com, tensor = inertial_of(path, "tuned")
+    assert mass == 0.1  # a valid mass in the file is kept: only the tensor was wrong
+    np.testing.assert_allclose(tensor, np.eye(3) * 0.1 * 0.02 / 12, rtol=1e-9, atol=0)
+    assert "hand-tuned for the controller" in path.read_text()  # the comment is not part of the edit
+    assert links_needing_inertia(load_model(path)) == {}
+    assert cli("fix-inertia", str(path), "--include-implausible", "--check").code == 0
+
+
+def test_implausible_links_by_hand_and_option_conflicts(cli, write_urdf):
+    path = write_urdf(PLACEHOLDER)
+    # --mass names the link: that is a request to recompute it.
+    by_mass = cli("fix-inertia", str(path), "--density", "1000", "--mass", "tuned=0.2", "--check",
+                  "--format", "json")
+    (file,) = json.loads(by_mass.stdout)["files"]
+    assert {c["element"] for c in file["changes"]} == {"link bare <inertial>", "link tuned <inertial>"}
+    assert file["notes"] == []
+    # --links and --all work as before, implausible or not.
+    by_links = cli("fix-inertia", str(path), "--links", "tuned", "--check", "--format", "json")
+    assert by_links.code == 1 and {c["element"] for c in json.loads(by_links.stdout)["files"][0]["changes"]} == \
+        {"link tuned <inertial>"}
+    by_all = cli("fix-inertia", str(path), "--all", "--density", "1000", "--check", "--format", "json")
+    assert by_all.code == 1 and {c["element"] for c in json.loads(by_all.stdout)["files"][0]["changes"]} == \
+        {"link bare <inertial>", "link tuned <inertial>"}
+    for other in (["--links", "tuned"], ["--all"]):
+        result = cli("fix-inertia", str(path), "--include-implausible", *other)
+        assert result.code == 2 and "--include-implausible widens the default selection" in result.stderr
+    assert path.read_text() == PLACEHOLDER

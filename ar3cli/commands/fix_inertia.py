@@ -12,8 +12,13 @@ from ar3cli.output import OutputFormat
 def fix_inertia(
     paths: FixPathsArgument,
     links: Annotated[Optional[str], typer.Option("--links", help="Comma-separated links to recompute "
-                                                 "(default: the links the linter flags).")] = None,
+                                                 "(default: the links the linter flags as invalid).")] = None,
     all_links: Annotated[bool, typer.Option("--all", help="Recompute every link that has geometry.")] = False,
+    include_implausible: Annotated[bool, typer.Option(
+        "--include-implausible",
+        help="Also recompute links whose inertia is valid but implausible for their geometry (I007: "
+             "often a hand-tuned value or a deliberate placeholder). By default they are left alone "
+             "and listed.")] = False,
     density: Annotated[Optional[float], typer.Option("--density", metavar="KG_PER_M3",
                                                      help="Density for links without a valid mass.")] = None,
     mass: Annotated[Optional[list[str]], typer.Option("--mass", metavar="LINK=KG",
@@ -29,6 +34,9 @@ def fix_inertia(
 ) -> None:
     """Recompute mass, centre of mass and inertia tensor of links from their geometry.
 
+    By default it fixes only links whose inertia is invalid (missing, mass <= 0, not positive
+    definite, A + B < C, all zero) and lists the valid but implausible ones (I007) it left alone;
+    --include-implausible recomputes those too.
     Edits only the fixed `<inertial>` elements, byte for byte, and writes atomically. A link
     without a valid mass needs --density, --mass or --total-mass: there is no default density.
     """
@@ -42,8 +50,11 @@ def fix_inertia(
         raise UserError(f"--total-mass {total_mass}: must be a positive number (kg)")
     if links is not None and all_links:
         raise UserError("--links and --all exclude each other")
+    if include_implausible and (links is not None or all_links):
+        raise UserError("--include-implausible widens the default selection; --links and --all already "
+                        "choose the links")
     names = [name.strip() for name in links.split(",") if name.strip()] if links is not None else None
-    options = InertiaOptions(names, all_links, density, parse_masses(mass), total_mass)
+    options = InertiaOptions(names, all_links, density, parse_masses(mass), total_mass, include_implausible)
     code = run_fixer("fix-inertia", paths, make_fixer(options), diff=diff, check=check, output=output, fmt=format,
                      package_path=package_path)
     raise typer.Exit(code)
