@@ -75,7 +75,7 @@ class Document:
         Raises when the scan and the parse disagree (then no edit is safe).
         """
         elements = [e for e in root.iter() if isinstance(e.tag, str)]
-        if len(elements) != len(self.spans) or any(e.tag != s.tag for e, s in zip(elements, self.spans)):
+        if len(elements) != len(self.spans) or any(_written_tag(e) != s.tag for e, s in zip(elements, self.spans)):
             raise UserError("cannot map the file's elements to byte positions safely; refusing to edit it")
         self._tree = root.getroottree()
         self._by_path = {self._tree.getpath(e): s for e, s in zip(elements, self.spans)}
@@ -263,6 +263,15 @@ def _skip_declaration(data: bytes, position: int) -> int:
             return index + 1
         index += 1
     raise UserError("unterminated declaration; refusing to edit the file")
+
+
+def _written_tag(element) -> str:
+    """The element's name as the file spells it: ``prefix:name`` for a namespaced element (lxml's
+    ``tag`` is ``{uri}name``, as in PR2's ``<controller:gazebo_ros_controller_manager>``)."""
+    if not element.tag.startswith("{"):
+        return element.tag
+    local = element.tag.rpartition("}")[2]
+    return f"{element.prefix}:{local}" if element.prefix else local
 
 
 def _start_tag(data: bytes, position: int, length: int) -> tuple[Span, int]:

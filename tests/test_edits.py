@@ -113,6 +113,37 @@ def test_fix_continuous_on_nasty_file_changes_one_line(cli, nasty):
                                                b"<limit effort='2'")
 
 
+NAMESPACED = """<?xml version="1.0"?>
+<robot name="ns" xmlns:controller="http://example.org/controller">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
+  <link name="arm"><collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>
+  <joint name="j" type="continuous"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-100" upper="100" effort="1" velocity="1"/></joint>
+  <controller:gazebo_ros_controller_manager name="m"><controller:rate>1</controller:rate></controller:gazebo_ros_controller_manager>
+</robot>
+"""
+
+
+def test_elements_with_a_namespace_prefix_map_to_their_spans():
+    """PR2 (example-robot-data) has <controller:...> elements; lxml names them {uri}name."""
+    from lxml import etree
+
+    document = Document(NAMESPACED.encode())
+    root = etree.fromstring(NAMESPACED.encode())
+    spans = document.bind(root)
+    element = root.find("{http://example.org/controller}gazebo_ros_controller_manager")
+    assert document.span(element).tag == "controller:gazebo_ros_controller_manager"
+    assert len(spans) == 16
+
+
+def test_fixers_edit_a_file_with_namespaced_elements(cli, tmp_path):
+    path = tmp_path / "ns.urdf"
+    path.write_text(NAMESPACED, encoding="utf-8")
+    result = cli("fix-continuous", str(path), "--no-verify")
+    assert result.code == 0, result.stderr
+    assert path.read_text(encoding="utf-8") == NAMESPACED.replace('<limit lower="-100" upper="100" ', "<limit ")
+
+
 def test_atomic_write_keeps_mode_and_leaves_no_temp(tmp_path):
     target = tmp_path / "robot.urdf"
     target.write_bytes(b"old")
