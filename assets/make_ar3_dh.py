@@ -1,7 +1,7 @@
 """Write ``ar3/ar3_dh.yaml``: the AR3's standard DH table, derived numerically from ``ar3/ar3.urdf``.
 
 Run from the repository root: ``python assets/make_ar3_dh.py``. The numbers come from
-:func:`ar3cli.dh.derive_standard` (joint axes of the URDF at the zero pose, common normals), with
+:func:`ar3cli.kinematics.dh.derive_standard` (joint axes of the URDF at the zero pose, common normals), with
 the axis signs (-1, 1, 1, 1, -1, 1) chosen so that frame 0 is the base link frame (z up) and the
 table looks like Annin Robotics' published one (alpha -90, 0, -90, -90, 90, 0 deg; d1, d4, d6 > 0).
 ``tests/test_fk_verify.py`` checks that the committed file still equals this derivation.
@@ -28,8 +28,8 @@ HEADER = """\
 def table_text() -> str:
     """The YAML text of the table (full double precision, so it matches to ~1e-15)."""
     sys.path.insert(0, str(HERE.parent))
-    from ar3cli import dh
-    from ar3cli.model import load_model
+    from ar3cli.kinematics import dh
+    from ar3cli.urdf.model import load_model
 
     doc = dh.derive_standard(load_model(HERE / "ar3" / "ar3.urdf"), "base_link", "link_6", SIGNS)
 

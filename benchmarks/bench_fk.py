@@ -23,8 +23,8 @@ def main(count: int = 10_000) -> None:
     import pybullet_data
     import yourdfpy
 
-    from ar3cli import kinematics
-    from ar3cli.model import load_model
+    from ar3cli.kinematics import fk as kinematics
+    from ar3cli.urdf.model import load_model
 
     path = Path(pybullet_data.getDataPath()) / "franka_panda" / "panda.urdf"
     model = load_model(path)

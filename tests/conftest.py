@@ -45,7 +45,7 @@ def cli():
 @pytest.fixture
 def session():
     """A fresh PyBullet session (DIRECT) for one test, closed afterwards."""
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     with Session() as opened:
         yield opened

@@ -21,8 +21,8 @@ import pybullet as p
 import pytest
 from lxml import etree
 
-from ar3cli import mass_properties as mp
-from ar3cli.capture import capture_fds
+from ar3cli.physics import mass_properties as mp
+from ar3cli.sim.capture import capture_fds
 from tests.conftest import ASSETS, REPO, SHARED
 
 AR3 = ASSETS / "ar3" / "ar3.urdf"

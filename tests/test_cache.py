@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from ar3cli.cache import MISSING, FileFacts, path_state
+from ar3cli.infra.file_cache import MISSING, FileFacts, path_state
 
 
 @pytest.fixture

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 from lxml import etree
 
-from ar3cli import collision_matrix as cm
-from ar3cli.adjacency import adjacent_pairs
-from ar3cli.collisions import Checker, ModelSource, count_collisions
-from ar3cli.model import load_model
-from ar3cli.sampling import limit_configurations, sample_configurations
-from ar3cli.sim import PENETRATION_TOLERANCE, Session
+from ar3cli.collisions import matrix as cm
+from ar3cli.sim.adjacency import adjacent_pairs
+from ar3cli.collisions.checker import Checker, ModelSource, count_collisions
+from ar3cli.urdf.model import load_model
+from ar3cli.sim.sampling import limit_configurations, sample_configurations
+from ar3cli.sim.session import PENETRATION_TOLERANCE, Session
 from tests.conftest import ASSETS
 
 ROBOTS = {
@@ -161,7 +161,7 @@ def test_png_heat_map(cli, tmp_path):
     image = Image.open(out).convert("RGB")
     assert image.width > 200 and image.height > 200
     colours = {colour for _, colour in image.getcolors(maxcolors=1 << 16)}
-    from ar3cli.heatmap_png import CATEGORY_COLOURS
+    from ar3cli.collisions.heatmap_png import CATEGORY_COLOURS
 
     assert CATEGORY_COLOURS["adjacent"] in colours and CATEGORY_COLOURS["never"] in colours
     srdf = tmp_path / "a.srdf"

@@ -64,7 +64,7 @@ def test_every_mentioned_command_and_option_exists(doc, line, command, rest):
 
 
 def test_readme_rule_count_matches_the_registry():
-    from ar3cli.rules import REGISTRY
+    from ar3cli.lint.rules import REGISTRY
 
     counts = re.findall(r"\| (\d+) rules \(", (REPO / "README.md").read_text(encoding="utf-8"))
     assert counts == [str(len(REGISTRY))]

@@ -10,7 +10,7 @@ import pytest
 from tests.conftest import ASSETS
 from tests.fixer_helpers import element_lines, lint_findings, only_within, write
 
-from ar3cli.model import load_model
+from ar3cli.urdf.model import load_model
 
 WHEEL = """<robot name="wheel">
   <link name="base"/>
@@ -36,7 +36,7 @@ WHEEL = """<robot name="wheel">
 
 def reached(path: Path, joint: str, target: float) -> float:
     """Position of ``joint`` after 10 s of POSITION_CONTROL towards ``target``."""
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     with Session() as session:
         body = session.load(load_model(path))
@@ -109,7 +109,7 @@ def real_ar3(shared_dir, tmp_path):
 def test_limits_from_moveit_yaml_on_the_real_ar3(cli, real_ar3):
     import yaml
 
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     real, path = real_ar3
     limits_file = real / "extra" / "ar3_moveit_config" / "config" / "joint_limits.yaml"

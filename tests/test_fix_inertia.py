@@ -11,9 +11,9 @@ import pytest
 from tests.conftest import ASSETS
 from tests.fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write
 
-from ar3cli import mass_properties as mp
-from ar3cli.inertia import capsule, links_needing_inertia
-from ar3cli.model import load_model
+from ar3cli.physics import mass_properties as mp
+from ar3cli.fix.geometry_mass import capsule, links_needing_inertia
+from ar3cli.urdf.model import load_model
 
 KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
@@ -140,7 +140,7 @@ def test_total_mass_is_spread_by_volume(cli, write_urdf):
 
 
 def _load_clean_in_pybullet(path: Path, package_path: dict | None = None) -> list[str]:
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     model = load_model(path, package_path)
     with Session() as session:
@@ -179,7 +179,7 @@ def test_injected_defects_on_ar3_asset(cli, tmp_path, defect):
 
 
 def test_frame_link_gets_a_tiny_inertial_and_leaves_gravity_torques_alone(cli, tmp_path):
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     original = (ASSETS / "ar3" / "ar3.urdf").read_text()
     path = write(tmp_path / "ar3.urdf", remove_inertial(original, "tcp"))

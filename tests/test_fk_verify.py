@@ -11,8 +11,10 @@ import numpy as np
 import pytest
 import yaml
 
-from ar3cli import dh, fk_compare, kinematics
-from ar3cli.model import load_model
+from ar3cli.kinematics import dh
+from ar3cli.kinematics import compare as fk_compare
+from ar3cli.kinematics import fk as kinematics
+from ar3cli.urdf.model import load_model
 from tests.conftest import ASSETS
 
 AR3 = ASSETS / "ar3" / "ar3.urdf"
@@ -104,7 +106,7 @@ def _com_frames(session, body, samples) -> dict[str, np.ndarray]:
 
 def test_com_instead_of_link_frame_fails_by_the_com_offset(write_urdf) -> None:
     """The tutorial trap: getLinkState[0] is the COM. [4] passes; [0] is off by exactly the inertial offset."""
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     path = write_urdf(_two_link_urdf(inertial_xyz="0.03 0.04 0.12"))
     model = load_model(path)
@@ -127,7 +129,7 @@ def test_mimic_joint_is_set_explicitly_and_explained(cli, write_urdf) -> None:
     assert result.code == 0, result.stderr
     assert any("mimics drive" in note and "does not enforce" in note for note in data["notes"])
     # without the explicit value pybullet leaves the mimic joint at 0: that would be a real error
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     model = load_model(path)
     with Session() as session:

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import json
 
-from ar3cli.adjacency import adjacent_pairs, nonadjacent_collisions
-from ar3cli.model import load_model
-from ar3cli.sim import Session
+from ar3cli.sim.adjacency import adjacent_pairs, nonadjacent_collisions
+from ar3cli.urdf.model import load_model
+from ar3cli.sim.session import Session
 
 PANDA_AT_HOME = {frozenset(("panda_link5", "panda_link7")), frozenset(("panda_link5", "panda_hand")),
                  frozenset(("panda_leftfinger", "panda_rightfinger"))}
@@ -48,8 +48,8 @@ def test_p002_render_and_sample_collisions_agree_on_panda(cli, pybullet_data_dir
 
 def test_p002_looks_through_a_link_without_geometry(write_urdf):
     """base - mid (no collision) - tip overlapping base: adjacent for MoveIt, so no P002 (it used to warn)."""
-    from ar3cli.lint import LintOptions, lint_file
-    from ar3cli.rules.base import LINK_INERTIAL, robot
+    from ar3cli.lint.engine import LintOptions, lint_file
+    from ar3cli.lint.rules.base import LINK_INERTIAL, robot
 
     box = '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'
     text = robot(f"""
@@ -66,8 +66,8 @@ def test_p002_looks_through_a_link_without_geometry(write_urdf):
 
 def test_p002_reports_a_shallow_overlap_in_micrometres(write_urdf):
     """5 um deep is above the 1 um tolerance (resting faces are ~1e-16 m) and is printed in um, not '0.0 mm'."""
-    from ar3cli.lint import LintOptions, lint_file
-    from ar3cli.rules import REGISTRY
+    from ar3cli.lint.engine import LintOptions, lint_file
+    from ar3cli.lint.rules import REGISTRY
 
     text = REGISTRY["P002"].bad.replace('<origin xyz="0 0 -0.25"/>', '<origin xyz="0 0 -0.100005"/>')
     options = LintOptions(sim=True)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from ar3cli import doctor
+from ar3cli.doctor import checks as doctor
 
 
 def test_json_is_clean_and_ok(cli):

@@ -8,9 +8,11 @@ from pathlib import Path
 
 import pytest
 
-from ar3cli import cache, lint_cache, model
-from ar3cli.cache import FileFacts
-from ar3cli.lint import LintOptions, _result_cache, lint_paths
+from ar3cli.infra import file_cache as cache
+from ar3cli.lint import result_cache as lint_cache
+from ar3cli.urdf import model
+from ar3cli.infra.file_cache import FileFacts
+from ar3cli.lint.engine import LintOptions, _result_cache, lint_paths
 
 MESH_ROBOT = """<?xml version="1.0"?>
 <robot name="r">
@@ -199,7 +201,7 @@ def test_a_dependency_that_changes_during_the_check_makes_the_entry_stale(store,
                                                                            monkeypatch) -> None:
     """States are recorded when a path is looked at: a mesh deleted after that, before the entry is
     stored, cannot hide behind its new state."""
-    import ar3cli.lint as engine
+    import ar3cli.lint.engine as engine
 
     path = write_urdf(MESH_ROBOT.format(uri="meshes/part.stl"))
     write_stl(tmp_path / "meshes" / "part.stl", 0.1)

@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from ar3cli.rules.base import arm
+from ar3cli.lint.rules.base import arm
 from tests.conftest import ASSETS
 
 ZERO_EFFORT = arm(joint_extra='<limit lower="-1" upper="1" effort="0" velocity="1"/>')  # J008 warning
@@ -68,7 +68,7 @@ def test_github_annotations_escape_properties_and_data(cli, write_urdf):
 
 
 def test_github_escape_functions():
-    from ar3cli.output_github import escape_data, escape_property
+    from ar3cli.output.github import escape_data, escape_property
 
     assert escape_data("50%\r\nnext") == "50%25%0D%0Anext"
     assert escape_property("a:b,c%") == "a%3Ab%2Cc%25"
@@ -228,7 +228,7 @@ def test_static_lint_does_not_import_numpy_pybullet_or_trimesh(tmp_path, pybulle
     files = [str(tmp_path / "r.urdf"), str(pybullet_data_dir / "franka_panda" / "panda.urdf")]
     code = ("import sys\nfrom ar3cli.cli import main\n"
             f"try:\n    main(['lint-urdf', '--format', 'json', *{files!r}])\nexcept SystemExit:\n    pass\n"
-            "from ar3cli.meshinfo import _mesh_bounds\nprint(_mesh_bounds.cache_info().currsize)\n"
+            "from ar3cli.urdf.meshinfo import _mesh_bounds\nprint(_mesh_bounds.cache_info().currsize)\n"
             "print(sorted(m for m in ('numpy', 'pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")
     env = {"PYTHONPATH": str(REPO), "NO_COLOR": "1", "PATH": "/usr/bin:/bin", "AR3CLI_CACHE_DIR": str(tmp_path / "c")}
     runs = []

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 
-from ar3cli.lint import LintOptions, lint_paths
-from ar3cli.rules.docs import generate
+from ar3cli.lint.engine import LintOptions, lint_paths
+from ar3cli.lint.rules.docs import generate
 from tests.conftest import REPO
 
 
@@ -77,7 +77,7 @@ def test_bundled_examples():
 
 def test_docs_rules_md_is_generated_from_the_registry():
     committed = (REPO / "docs" / "rules.md").read_text(encoding="utf-8")
-    assert committed == generate(), "docs/rules.md is stale: python -m ar3cli.rules.docs > docs/rules.md"
+    assert committed == generate(), "docs/rules.md is stale: python -m ar3cli.lint.rules.docs > docs/rules.md"
 
 
 def test_pre_commit_hooks_file():

@@ -12,9 +12,9 @@ from pathlib import Path
 import pytest
 
 from ar3cli.findings import Severity
-from ar3cli.lint import LintOptions, lint_file
-from ar3cli.rules import REGISTRY, RULES
-from ar3cli.rules.base import LINK_INERTIAL, arm, robot
+from ar3cli.lint.engine import LintOptions, lint_file
+from ar3cli.lint.rules import REGISTRY, RULES
+from ar3cli.lint.rules.base import LINK_INERTIAL, arm, robot
 
 LFS_POINTER = (b"version https://git-lfs.github.com/spec/v1\n"
                b"oid sha256:4d7a214614ab2935c943f9e0ff69d22eadbb8f32b1258daaa5e2ca24d17e2393\nsize 12345\n")

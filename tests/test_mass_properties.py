@@ -1,4 +1,4 @@
-"""Tests for ar3cli.mass_properties: textbook values, combination and validity checks."""
+"""Tests for ar3cli.physics.mass_properties: textbook values, combination and validity checks."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ar3cli import mass_properties as mp
+from ar3cli.physics import mass_properties as mp
 
 EXACT = 1e-9
 

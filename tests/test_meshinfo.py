@@ -8,7 +8,7 @@ import struct
 import numpy as np
 import pytest
 
-from ar3cli import meshinfo
+from ar3cli.urdf import meshinfo
 
 
 def _binary_stl(triangles: list[list[tuple[float, float, float]]]) -> bytes:
@@ -73,7 +73,8 @@ def test_disk_cache_reuses_and_invalidates(tmp_path, monkeypatch):
     """Bounds survive the process (keyed by path, mtime, size); an edited mesh is read again."""
     import os
 
-    from ar3cli import cache, meshinfo
+    from ar3cli.infra import file_cache as cache
+    from ar3cli.urdf import meshinfo
 
     monkeypatch.setenv("AR3CLI_CACHE_DIR", str(tmp_path / "cache"))
     mesh = tmp_path / "m.obj"

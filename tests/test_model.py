@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 
 from ar3cli.errors import UserError
-from ar3cli.model import load_model, parse_floats
-from ar3cli.packages import PackageResolver, parse_package_paths
+from ar3cli.urdf.model import load_model, parse_floats
+from ar3cli.urdf.packages import PackageResolver, parse_package_paths
 
 ARM = """<?xml version="1.0"?>
 <robot name="arm">
@@ -133,7 +133,7 @@ def test_directory_is_refused(tmp_path):
 
 
 def test_size_cap(tmp_path, monkeypatch):
-    from ar3cli import xmlsource
+    from ar3cli.urdf import xmlsource
 
     monkeypatch.setattr(xmlsource, "MAX_FILE_BYTES", 100)
     path = _write(tmp_path / "big.urdf", ARM.encode())
@@ -267,7 +267,7 @@ def test_xacro_missing_include_is_said_once(tmp_path):
 
 def test_joint_type_sets_are_defined_once(write_urdf):
     """ACTUATED (pybullet's 1-DOF joints) is a subset of MOVING; a spherical joint moves its child."""
-    from ar3cli import model as model_module
+    from ar3cli.urdf import model as model_module
 
     assert model_module.ACTUATED_JOINT_TYPES == ("revolute", "continuous", "prismatic")
     assert set(model_module.ACTUATED_JOINT_TYPES) < set(model_module.MOVING_JOINT_TYPES)

@@ -6,7 +6,7 @@ import io
 
 from rich.console import Console
 
-from ar3cli.output import Report, Table, plain_table, render_table
+from ar3cli.output.report import Report, Table, plain_table, render_table
 
 TABLE = Table(title="t.urdf", columns=["location", "code", "severity", "message"],
               rows=[["t.urdf:3:5", "I001", "error", "link 'a' moves but has no <inertial>: PyBullet uses 1 kg"]],
@@ -31,7 +31,7 @@ def test_narrow_terminal_prints_blocks_and_wide_prints_a_table():
 
 
 def test_report_text_payload_goes_to_stdout_and_tables_to_stderr(capsys):
-    from ar3cli.output import render
+    from ar3cli.output.report import render
 
     render(Report(data={"a": 1}, tables=[TABLE], lines=["summary"], text="--- a/x\n+++ b/x\n"), "text")
     captured = capsys.readouterr()

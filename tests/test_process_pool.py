@@ -9,9 +9,9 @@ import signal
 
 import pytest
 
-from ar3cli import process_pool
+from ar3cli.infra import process_pool
 from ar3cli.errors import UserError
-from ar3cli.process_pool import map_in_processes, worker_count
+from ar3cli.infra.process_pool import map_in_processes, worker_count
 
 pytestmark = pytest.mark.skipif(not process_pool.can_fork(), reason="forked workers are used on Linux only")
 several_cpus = pytest.mark.skipif(process_pool.available_cpus() < 2,
@@ -131,7 +131,7 @@ def test_when_the_system_refuses_a_process_this_one_does_the_work(monkeypatch, n
 
 ORPHAN_SCRIPT = """
 import os, signal, sys, time
-from ar3cli.process_pool import map_in_processes
+from ar3cli.infra.process_pool import map_in_processes
 PARENT = os.getpid()
 def work(item):
     if os.getpid() != PARENT:

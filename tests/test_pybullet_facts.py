@@ -10,10 +10,10 @@ from pathlib import Path
 
 import pytest
 
-from ar3cli.isolation import CrashError, run_isolated
-from ar3cli.model import load_model
-from ar3cli.process_pool import can_fork
-from ar3cli.sim import Session
+from ar3cli.infra.isolation import CrashError, run_isolated
+from ar3cli.urdf.model import load_model
+from ar3cli.infra.process_pool import can_fork
+from ar3cli.sim.session import Session
 
 CYLINDER = """<robot name="c"><link name="a"><inertial><mass value="1"/>
 <inertia ixx="0.0158333333333" ixy="0" ixz="0" iyy="0.0158333333333" iyz="0" izz="0.005"/></inertial>
@@ -90,8 +90,8 @@ def test_random_seed_is_not_a_physics_parameter(session):
 
 def test_file_caching_serves_stale_content_under_the_same_name(tmp_path):
     """Why ar3cli's Session turns caching off and loads fresh copies: pybullet caches by file name."""
-    from ar3cli.capture import capture_fds
-    from ar3cli.sim import import_pybullet
+    from ar3cli.sim.capture import capture_fds
+    from ar3cli.sim.session import import_pybullet
 
     p = import_pybullet()
     path = tmp_path / "r.urdf"

@@ -15,10 +15,10 @@ from pathlib import Path
 import pytest
 
 from ar3cli.errors import UserError
-from ar3cli.isolation import CrashError, report_stage, run_isolated
-from ar3cli.loadable_copy import loadable_document, parent_first_order
-from ar3cli.model import load_model
-from ar3cli.process_pool import can_fork
+from ar3cli.infra.isolation import CrashError, report_stage, run_isolated
+from ar3cli.sim.loadable_copy import loadable_document, parent_first_order
+from ar3cli.urdf.model import load_model
+from ar3cli.infra.process_pool import can_fork
 
 DATA = Path(__file__).parent / "data" / "link_order"
 REORDERED = ["root_last.urdf", "root_middle.urdf", "child_before_parent.urdf"]
@@ -66,7 +66,7 @@ def test_the_users_model_is_not_reordered() -> None:
 
 # ---- every order loads, with the right frame under every name -----------------------------------
 def _frames(name: str, positions: dict[str, float]) -> dict[str, tuple]:
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     with Session() as session:
         body = session.load(load_model(DATA / name))
@@ -165,7 +165,7 @@ def test_run_isolated_names_the_signal_and_the_stage(tmp_path, monkeypatch) -> N
 
 @needs_fork
 def test_install_check_reports_a_crashing_check_and_goes_on() -> None:
-    from ar3cli.doctor import Check, run_checks
+    from ar3cli.doctor.checks import Check, run_checks
 
     def check_boom() -> Check:
         os.kill(os.getpid(), signal.SIGSEGV)

@@ -8,10 +8,10 @@ import textwrap
 
 import pytest
 
-from ar3cli.capture import split_bullet_messages
+from ar3cli.sim.capture import split_bullet_messages
 from ar3cli.errors import UserError
-from ar3cli.model import load_model
-from ar3cli.sim import Session
+from ar3cli.urdf.model import load_model
+from ar3cli.sim.session import Session
 
 OFFSET_COM = """<?xml version="1.0"?>
 <robot name="pendulum">
@@ -118,8 +118,8 @@ def test_nothing_of_pybullet_reaches_stdout(cli, tmp_path):
     script = tmp_path / "s.py"
     script.write_text(textwrap.dedent(f"""
         import json
-        from ar3cli.model import load_model
-        from ar3cli.sim import Session
+        from ar3cli.urdf.model import load_model
+        from ar3cli.sim.session import Session
         with Session() as s:
             body = s.load(load_model({str(robot)!r}))
             print(json.dumps({{"links": body.link_names, "messages": len(s.messages)}}))

@@ -18,10 +18,10 @@ Two measured facts shape this module:
   what makes the merged counts identical for any number of jobs.
 - ``getContactPoints`` also reports points at small positive distance (up to ~4 mm on the panda) and
   faces that rest exactly on each other (distance ~1e-17). A pair counts as *colliding* only when it
-  penetrates deeper than :data:`~ar3cli.sim.PENETRATION_TOLERANCE` (1 um), the threshold lint-urdf's
+  penetrates deeper than :data:`~ar3cli.sim.session.PENETRATION_TOLERANCE` (1 um), the threshold lint-urdf's
   P002 and render use too.
 
-Configurations are generated up front in the parent by :mod:`ar3cli.sampling` (only the driving
+Configurations are generated up front in the parent by :mod:`ar3cli.sim.sampling` (only the driving
 joints are drawn from ``numpy.random.default_rng(seed)``; ``<mimic>`` joints follow), split
 into chunks, counted by worker processes (one PyBullet client each) and summed: the counts are exact
 and independent of the number of jobs.
@@ -38,11 +38,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ar3cli.adjacency import collision_links
+from ar3cli.sim.adjacency import collision_links
 from ar3cli.errors import UserError
-from ar3cli.model import Model, load_model
-from ar3cli.sampling import JointSpace, joint_space
-from ar3cli.sim import PENETRATION_TOLERANCE
+from ar3cli.urdf.model import Model, load_model
+from ar3cli.sim.sampling import JointSpace, joint_space
+from ar3cli.sim.session import PENETRATION_TOLERANCE
 
 __all__ = ["Checker", "ModelSource", "count_collisions"]
 
@@ -70,7 +70,7 @@ class Checker:
     """
 
     def __init__(self, model: Model) -> None:
-        from ar3cli.sim import Session
+        from ar3cli.sim.session import Session
 
         self.session = Session()
         try:
@@ -103,7 +103,7 @@ class Checker:
         self.session.close()
 
     def joint_space(self) -> JointSpace:
-        """The body's joint space (:mod:`ar3cli.sampling`): mimic joints follow their source."""
+        """The body's joint space (:mod:`ar3cli.sim.sampling`): mimic joints follow their source."""
         return joint_space(self.body)
 
     def colliding(self, q: Sequence[float]) -> list[int]:

@@ -3,7 +3,7 @@
 Lower triangle, one cell per pair of links with collision geometry. Colour says the category
 (MoveIt's): adjacent grey-blue, default red, always magenta, never pale green, sometimes a yellow to
 orange ramp by the colliding fraction (its percentage is written in the cell). The same data as
-the terminal heat map (:func:`ar3cli.collision_matrix.heat_map`), drawn with Pillow.
+the terminal heat map (:func:`ar3cli.collisions.matrix.heat_map`), drawn with Pillow.
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ from __future__ import annotations
 import io
 from collections.abc import Sequence
 
-from ar3cli.collision_matrix import PairResult
+from ar3cli.collisions.matrix import PairResult
 
 CELL = 34
 MARGIN = 12

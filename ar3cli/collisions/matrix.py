@@ -4,7 +4,7 @@ Categories, in MoveIt's order of precedence (``compute_default_collisions.cpp``)
 
 1. ``adjacent``: joined by a joint, links without collision geometry being transparent (removed and
    their neighbours joined), so parent and grandchild across a geometry-less link are adjacent
-   (:func:`ar3cli.adjacency.adjacent_pairs`, shared with lint-urdf's P002 and render).
+   (:func:`ar3cli.sim.adjacency.adjacent_pairs`, shared with lint-urdf's P002 and render).
 2. ``default``: in contact at the home pose (0, or mid-range where 0 is outside the limits).
 3. ``always``: in contact in at least ``always_threshold`` (0.95) of the uniform samples.
 4. ``never``: never in contact, neither in the uniform samples nor in any limit configuration
@@ -24,9 +24,9 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
-from ar3cli.adjacency import direct_parent_child
+from ar3cli.sim.adjacency import direct_parent_child
 from ar3cli.findings import Finding, Severity
-from ar3cli.model import Model
+from ar3cli.urdf.model import Model
 
 __all__ = ["classify", "findings", "srdf_bytes"]
 

@@ -5,8 +5,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
-from ar3cli.output import OutputFormat
+from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.output.report import OutputFormat
 
 
 def fix_continuous(
@@ -34,9 +34,9 @@ def fix_continuous(
     into revolute joints with the real limits. Edits only those joints, byte for byte, atomically.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix_continuous_plan import ContinuousOptions, make_fixer, read_joint_limits
-    from ar3cli.fix_continuous_plan import verify as verify_in_pybullet
-    from ar3cli.fixing import run_fixer
+    from ar3cli.fix.continuous_plan import ContinuousOptions, make_fixer, read_joint_limits
+    from ar3cli.fix.continuous_plan import verify as verify_in_pybullet
+    from ar3cli.fix.driver import run_fixer
 
     for name, value in (("--effort", effort), ("--velocity", velocity)):
         if value is not None and not value > 0:

@@ -6,9 +6,9 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ar3cli.errors import UserError
-from ar3cli.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
+from ar3cli.commands.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
                             load_from_options, samples_option)
-from ar3cli.output import OutputFormat, Report, Table, finish, log
+from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 
 SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
@@ -38,9 +38,9 @@ def fk_verify(
     """
     import numpy as np
 
-    from ar3cli import dh as dh_module
-    from ar3cli import fk_compare
-    from ar3cli.sim import Session, run_pybullet
+    from ar3cli.kinematics import dh as dh_module
+    from ar3cli.kinematics import compare as fk_compare
+    from ar3cli.sim.session import Session, run_pybullet
 
     if not (tolerance_m > 0 and tolerance_rad > 0):
         raise UserError("--tolerance-m and --tolerance-rad must be positive")

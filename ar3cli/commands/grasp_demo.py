@@ -8,8 +8,8 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ar3cli.errors import UserError
-from ar3cli.options import FormatOption, SeedOption
-from ar3cli.output import OutputFormat, Report, Table, finish, log
+from ar3cli.commands.options import FormatOption, SeedOption
+from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 
 TARGET_RATE = 0.95
 """--trials exits 1 below this success rate (the issue's target on the default region)."""
@@ -37,7 +37,7 @@ def grasp_demo(
     position-controlled within the model's effort limits, and only friction holds the cube.
     Exit 1 when the grasp fails (the phase and the reason are printed).
     """
-    from ar3cli.grasp import GraspSettings, demo_camera, run_grasp, run_trials
+    from ar3cli.grasp.pick_and_lift import GraspSettings, demo_camera, run_grasp, run_trials
 
     if gripper_force <= 0:
         raise UserError(f"--gripper-force must be positive, got {gripper_force:g}")
@@ -57,7 +57,7 @@ def grasp_demo(
 
     recorder = None
     if record is not None:
-        from ar3cli.recording import GifRecorder, check_gif_path
+        from ar3cli.pictures.recording import GifRecorder, check_gif_path
 
         check_gif_path(record)
         recorder = GifRecorder(**demo_camera(seed, settings))

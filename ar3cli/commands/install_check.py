@@ -1,8 +1,8 @@
 """``ar3cli install-check``: the environment doctor."""
 
 
-from ar3cli.options import FormatOption
-from ar3cli.output import OutputFormat, Report, Table, finish
+from ar3cli.commands.options import FormatOption
+from ar3cli.output.report import OutputFormat, Report, Table, finish
 
 
 def install_check(format: FormatOption = OutputFormat.text) -> None:
@@ -11,7 +11,7 @@ def install_check(format: FormatOption = OutputFormat.text) -> None:
     Each check prints ok / warn / fail / info, a detail, and for problems the exact command to run.
     Exit code 1 when any check fails.
     """
-    from ar3cli.doctor import run_checks
+    from ar3cli.doctor.checks import run_checks
 
     checks = run_checks()
     ok = not any(check.status == "fail" for check in checks)

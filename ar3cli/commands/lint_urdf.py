@@ -8,8 +8,8 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.errors import UserError
-from ar3cli.options import PackagePathOption, XacroArgOption
-from ar3cli.output import Report, Table, finish
+from ar3cli.commands.options import PackagePathOption, XacroArgOption
+from ar3cli.output.report import Report, Table, finish
 
 
 class LintFormat(str, enum.Enum):
@@ -67,11 +67,11 @@ def lint_urdf(
     Exit codes: 0 clean, 1 findings at or above --fail-on, 2 usage or I/O error.
     """
     from ar3cli.findings import Severity
-    from ar3cli.lint import LintOptions, lint_paths, summarize
-    from ar3cli.lint_config import LintConfig, load_config
-    from ar3cli.packages import parse_package_paths
-    from ar3cli.rules import validate_patterns
-    from ar3cli.xacro_expand import parse_xacro_args
+    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
+    from ar3cli.lint.config import LintConfig, load_config
+    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.lint.rules import validate_patterns
+    from ar3cli.urdf.xacro_expand import parse_xacro_args
 
     config = LintConfig() if no_config else load_config()
     try:
@@ -116,11 +116,11 @@ def render_lint(results, summary: dict, options, fmt: LintFormat) -> Report:
     data = {"files": [r.to_dict() for r in results], "findings": [f.to_dict() for f in findings], "summary": summary}
     ok = not summary["failed"]
     if fmt is LintFormat.sarif:
-        from ar3cli.output_sarif import sarif_document
+        from ar3cli.output.sarif import sarif_document
 
         return Report(data=sarif_document(findings, options.rules()), ok=ok)
     if fmt in (LintFormat.github, LintFormat.markdown):
-        from ar3cli.output_github import annotation, markdown_table
+        from ar3cli.output.github import annotation, markdown_table
 
         table = markdown_table(findings, summary_line(summary))
         if fmt is LintFormat.markdown:

@@ -8,7 +8,7 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.errors import UserError
-from ar3cli.output import OutputFormat
+from ar3cli.output.report import OutputFormat
 
 FormatOption = Annotated[
     OutputFormat,
@@ -46,9 +46,9 @@ OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_def
 
 def load_from_options(path: Path, package_path: list[str] | None, xacro_arg: list[str] | None):
     """Parse the shared loading options and load the model; malformed options raise UserError."""
-    from ar3cli.model import load_model
-    from ar3cli.packages import parse_package_paths
-    from ar3cli.xacro_expand import parse_xacro_args
+    from ar3cli.urdf.model import load_model
+    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.urdf.xacro_expand import parse_xacro_args
 
     try:
         packages = parse_package_paths(package_path)

@@ -5,8 +5,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, load_from_options
-from ar3cli.output import OutputFormat, Report, Table, finish
+from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, load_from_options
+from ar3cli.output.report import OutputFormat, Report, Table, finish
 
 
 def render_command(
@@ -31,8 +31,8 @@ def render_command(
     Links in contact with a link they are not joined to are drawn red: the problem `lint-urdf --sim` reports.
     No display or GPU is needed.
     """
-    from ar3cli.render import parse_configuration
-    from ar3cli.render import render as draw
+    from ar3cli.pictures.render import parse_configuration
+    from ar3cli.pictures.render import render as draw
 
     configuration = parse_configuration(config)
     model = load_from_options(path, package_path, xacro_arg)

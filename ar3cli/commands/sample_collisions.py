@@ -7,9 +7,9 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.errors import UserError
-from ar3cli.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
+from ar3cli.commands.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
                             samples_option)
-from ar3cli.output import OutputFormat, Report, Table, console, finish
+from ar3cli.output.report import OutputFormat, Report, Table, console, finish
 
 SamplesOption = Annotated[int, samples_option("Uniform random configurations to check (MoveIt's default: 10000).",
                                               most=10_000_000)]
@@ -48,11 +48,11 @@ def sample_collisions(
     the 95% upper bound on its collision probability, 'sometimes' with a Wilson 95% interval. The
     home pose and every driving joint at its limits (mimic joints follow) are checked too. Exit 0 when the matrix was computed.
     """
-    from ar3cli import collision_matrix as cm
-    from ar3cli.adjacency import collision_links
-    from ar3cli.adjacency import adjacent_pairs
-    from ar3cli.collisions import Checker
-    from ar3cli.sim import run_pybullet
+    from ar3cli.collisions import matrix as cm
+    from ar3cli.sim.adjacency import collision_links
+    from ar3cli.sim.adjacency import adjacent_pairs
+    from ar3cli.collisions.checker import Checker
+    from ar3cli.sim.session import run_pybullet
 
     _check_outputs(srdf, pybullet_filter, png)
     model = _load(path, package_path, xacro_arg)
@@ -76,7 +76,7 @@ def sample_collisions(
     if pybullet_filter is not None:
         _write(pybullet_filter, cm.pybullet_filter_bytes(results, comment))
     if png is not None:
-        from ar3cli.heatmap_png import heat_map_png
+        from ar3cli.collisions.heatmap_png import heat_map_png
 
         _write(png, heat_map_png(links, pairs, results, title=f"{model.name or model.path.name}: "
                                                              f"{samples} samples, seed {seed}"))
@@ -86,7 +86,7 @@ def sample_collisions(
 
 def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | None) -> None:
     """Refuse unusable output paths before minutes of sampling, not after."""
-    from ar3cli.atomic import check_writable
+    from ar3cli.infra.atomic import check_writable
 
     if png is not None and png.suffix.lower() != ".png":
         raise UserError(f"--png {png}: the file name must end in .png")
@@ -96,23 +96,23 @@ def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | 
 
 
 def _load(path, package_path, xacro_arg):
-    from ar3cli.options import load_from_options
+    from ar3cli.commands.options import load_from_options
 
     return load_from_options(path, package_path, xacro_arg)
 
 
 def _source(model, package_path, xacro_arg):
     """What a worker process needs to load the same model again."""
-    from ar3cli.collisions import ModelSource
-    from ar3cli.packages import parse_package_paths
-    from ar3cli.xacro_expand import parse_xacro_args
+    from ar3cli.collisions.checker import ModelSource
+    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.urdf.xacro_expand import parse_xacro_args
 
     return ModelSource(model.path, dict(parse_package_paths(package_path) or {}),
                        dict(parse_xacro_args(xacro_arg) or {}))
 
 
 def _no_pairs_message(model) -> str:
-    from ar3cli.adjacency import collision_links
+    from ar3cli.sim.adjacency import collision_links
 
     solid = collision_links(model)
     visual_only = [link.name for link in model.links if link.visuals and link.name not in solid]
@@ -129,8 +129,8 @@ def _no_pairs_message(model) -> str:
 
 def _run(checker, source, samples: int, seed: int, jobs: int) -> dict:
     """Home + limit configurations, then the uniform samples (counted, timed, with progress)."""
-    from ar3cli.collisions import count_collisions
-    from ar3cli.sampling import limit_configurations, sample_configurations
+    from ar3cli.collisions.checker import count_collisions
+    from ar3cli.sim.sampling import limit_configurations, sample_configurations
 
     space = checker.joint_space()
     home_hits: set[int] = set()
@@ -178,14 +178,14 @@ class _progress:
 
 
 def _write(path: Path, data: bytes) -> None:
-    from ar3cli.atomic import atomic_write
+    from ar3cli.infra.atomic import atomic_write
 
     atomic_write(path, data)
 
 
 def _report(model, results, links, pairs, warnings, run, samples, seed, jobs, threshold, fmt) -> Report:
     """The matrix as a Report: table, heat map and summary lines; always ok (findings don't fail the run)."""
-    from ar3cli import collision_matrix as cm
+    from ar3cli.collisions import matrix as cm
 
     rate = samples / run["elapsed"] if run["elapsed"] > 0 else None
     counts = cm.category_counts(results)
@@ -232,6 +232,6 @@ def _count(number: int, noun: str) -> str:
 
 
 def _tolerance() -> float:
-    from ar3cli.sim import PENETRATION_TOLERANCE
+    from ar3cli.sim.session import PENETRATION_TOLERANCE
 
     return PENETRATION_TOLERANCE

@@ -19,7 +19,7 @@ from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from ar3cli.capture import capture_fds
+from ar3cli.sim.capture import capture_fds
 
 MIN_PYTHON = (3, 10)
 STEPS = 240
@@ -72,7 +72,7 @@ def check_numpy() -> Check:
         import numpy
     except ImportError as exc:
         return Check("numpy", "fail", f"cannot import numpy: {exc}", "pip install numpy")
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     with Session() as session:
         image = session.p.getCameraImage(8, 8, renderer=session.p.ER_TINY_RENDERER, physicsClientId=session.client)
@@ -97,7 +97,7 @@ def _small_scene(session) -> list[int]:
 
 
 def _final_states(seconds_per_step: list[float] | None = None) -> list[tuple]:
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     with Session() as session:
         bodies = _small_scene(session)
@@ -206,10 +206,10 @@ CHECKS: list[Callable[[], Check]] = [
 
 
 def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
-    """Run every check, each in a forked child (:mod:`ar3cli.isolation`): an exception inside one
+    """Run every check, each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside one
     becomes a ``fail`` for that check only, and so does a crash of pybullet's C code (a broken
     build), which would otherwise end install-check with no report at all."""
-    from ar3cli.isolation import CrashError, run_isolated
+    from ar3cli.infra.isolation import CrashError, run_isolated
 
     results = []
     for check in checks or CHECKS:

@@ -18,9 +18,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ar3cli.edits import Document
+from ar3cli.fix.edits import Document
 from ar3cli.errors import UserError
-from ar3cli.fixing import Change, FixPlan, Skipped, number
+from ar3cli.fix.driver import Change, FixPlan, Skipped, number
 
 FULL_TURN = 2.0 * math.pi
 FULL_TURN_TOLERANCE = 1e-6
@@ -49,7 +49,7 @@ class ContinuousOptions:
 
 def read_joint_limits(path: Path) -> dict[str, YamlLimits]:
     """Parse MoveIt's ``joint_limits.yaml`` (top key ``joint_limits``); errors are one-line UserErrors."""
-    from ar3cli.yamlfile import load_yaml
+    from ar3cli.urdf.yamlfile import load_yaml
 
     data = load_yaml(path, "joint limits file")
     if not isinstance(data, dict) or not isinstance(data.get("joint_limits"), dict):
@@ -240,7 +240,7 @@ def _full_turn_to_continuous(document: Document, plan: FixPlan, joint) -> None:
 def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; check each changed joint's limits (and that a target
     beyond a removed fake limit is reached)."""
-    from ar3cli.sim import run_pybullet
+    from ar3cli.sim.session import run_pybullet
 
     joints = plan.context.get("joints", {})
     if not joints:
@@ -254,7 +254,7 @@ def verify(model, plan: FixPlan) -> dict:
 
 def _checks_in_pybullet(model, joints: dict) -> list[dict]:
     """Each changed joint's limits as pybullet loads them, and a drive past a removed fake limit."""
-    from ar3cli.sim import Session
+    from ar3cli.sim.session import Session
 
     checks: list[dict] = []
     with Session() as session:

@@ -1,7 +1,7 @@
 """The plumbing shared by every fixer: load, plan edits, diff / check / write, report.
 
 A fixer is a function ``(model, document) -> FixPlan`` that queues byte splices on the
-:class:`~ar3cli.edits.Document` and records a :class:`Change` for each field it changes (with
+:class:`~ar3cli.fix.edits.Document` and records a :class:`Change` for each field it changes (with
 old value, new value and where the new number came from) and a :class:`Skipped` for each element
 it could not fix. :func:`run_fixer` does everything else the same way for all fixers: refuses
 xacro, builds the new bytes, checks they still parse, prints a diff (``--diff``), reports
@@ -17,10 +17,10 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ar3cli.atomic import atomic_write, check_writable
-from ar3cli.edits import Document
+from ar3cli.infra.atomic import atomic_write, check_writable
+from ar3cli.fix.edits import Document
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
-from ar3cli.output import OutputFormat, Report, Table, render
+from ar3cli.output.report import OutputFormat, Report, Table, render
 
 
 @dataclass
@@ -97,7 +97,7 @@ def number(value: float) -> str:
 
 
 def refuse_xacro(paths: list[Path]) -> None:
-    from ar3cli.xacro_expand import is_xacro
+    from ar3cli.urdf.xacro_expand import is_xacro
 
     for path in paths:
         if is_xacro(path):
@@ -113,7 +113,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     Every file is loaded and planned before the first write: a bad second input stops the run
     with no file changed, instead of after the first one was rewritten.
     """
-    from ar3cli.options import load_from_options
+    from ar3cli.commands.options import load_from_options
 
     if not paths:
         raise UserError("give at least one file")
@@ -151,14 +151,14 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
 
 
 def _check_parses(path: Path, data: bytes) -> None:
-    from ar3cli import xmlsource
+    from ar3cli.urdf import xmlsource
 
     normalized, _ = xmlsource.normalize(data)
     xmlsource.parse(normalized, path)  # raises UserError (a fixer bug) rather than writing junk
 
 
 def unified_diff(path: Path, old: bytes, new: bytes) -> str:
-    from ar3cli.xmlsource import decode_text
+    from ar3cli.urdf.xmlsource import decode_text
 
     return "".join(difflib.unified_diff(decode_text(old).splitlines(keepends=True),
                                         decode_text(new).splitlines(keepends=True),

@@ -10,7 +10,7 @@ lxml elements, so an lxml element is mapped to its span by its index in that ord
 
 Edits are collected as non-overlapping splices ``(start, end, new_bytes)`` and applied in one
 go by :meth:`Document.apply`. New text is ASCII, so it is valid in any ASCII-compatible
-encoding the file may declare. Writing the result is :func:`ar3cli.atomic.atomic_write`'s job.
+encoding the file may declare. Writing the result is :func:`ar3cli.infra.atomic.atomic_write`'s job.
 """
 
 from __future__ import annotations

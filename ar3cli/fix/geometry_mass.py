@@ -1,6 +1,6 @@
 """Mass properties of a link from its geometry, and which links need new ones.
 
-Primitives use :mod:`ar3cli.mass_properties` (exact, analytic). Meshes use trimesh: scale
+Primitives use :mod:`ar3cli.physics.mass_properties` (exact, analytic). Meshes use trimesh: scale
 applied, exact signed-tetrahedra volume when the mesh is watertight, otherwise its convex hull
 with the hull/mesh volume ratio reported. Each shape's ``<origin>`` is applied and the shapes of
 a link are combined with the parallel-axis theorem. Everything is computed at density 1 (so the
@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ar3cli import mass_properties as mp
-from ar3cli.model import Link, Model, Shape
+from ar3cli.physics import mass_properties as mp
+from ar3cli.urdf.model import Link, Model, Shape
 
 FRAME_LINK_MASS = 1e-6
 """kg written for a frame link (no geometry, fixed joint); see docs/commands/fix-inertia.md."""
@@ -201,8 +201,8 @@ def links_needing_inertia(model: Model) -> dict[str, str]:
     The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
     so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
     """
-    from ar3cli.lint import Context, LintOptions, suppressed_inline
-    from ar3cli.rules.inertia import RULES
+    from ar3cli.lint.engine import Context, LintOptions, suppressed_inline
+    from ar3cli.lint.rules.inertia import RULES
 
     context = Context(model, LintOptions())
     found: dict[str, str] = {}

@@ -24,12 +24,12 @@ from dataclasses import asdict, dataclass, field
 
 import numpy as np
 
-from ar3cli import inertia
-from ar3cli import mass_properties as mp
-from ar3cli.edits import Document
+from ar3cli.fix import geometry_mass as inertia
+from ar3cli.physics import mass_properties as mp
+from ar3cli.fix.edits import Document
 from ar3cli.errors import UserError
-from ar3cli.fixing import Change, FixPlan, Skipped, number
-from ar3cli.rules.inertia import inertia_implausible
+from ar3cli.fix.driver import Change, FixPlan, Skipped, number
+from ar3cli.lint.rules.inertia import inertia_implausible
 
 TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 IMPLAUSIBLE_CODES = frozenset({inertia_implausible.code})
@@ -83,7 +83,7 @@ def parse_masses(values: list[str] | None) -> dict[str, float]:
 
 
 def make_fixer(options: InertiaOptions):
-    """The fixer function for :func:`ar3cli.fixing.run_fixer`."""
+    """The fixer function for :func:`ar3cli.fix.driver.run_fixer`."""
 
     def fix(model, document: Document) -> FixPlan:
         return plan_inertia(model, document, options)

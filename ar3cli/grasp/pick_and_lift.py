@@ -230,9 +230,9 @@ class GraspScene:
 
     def __init__(self, seed: int, settings: GraspSettings, gui: bool = False,
                  frame_hook: FrameHook | None = None, realtime: bool = False) -> None:
-        from ar3cli.assets import asset
-        from ar3cli.model import load_model
-        from ar3cli.sim import Session
+        from ar3cli.infra.assets import asset
+        from ar3cli.urdf.model import load_model
+        from ar3cli.sim.session import Session
 
         self.settings = settings
         self.frame_hook = frame_hook
@@ -553,8 +553,8 @@ def run_grasp(seed: int = 0, settings: GraspSettings | None = None, gui: bool = 
     settings = settings or GraspSettings()
     if not 0 < settings.gripper_force:
         raise UserError(f"--gripper-force must be positive, got {settings.gripper_force}")
-    import ar3cli.model  # noqa: F401  (imports are a one-off per process, not the demo's time)
-    from ar3cli.sim import import_pybullet
+    import ar3cli.urdf.model  # noqa: F401  (imports are a one-off per process, not the demo's time)
+    from ar3cli.sim.session import import_pybullet
 
     import_pybullet()
     wall_start = time.perf_counter()

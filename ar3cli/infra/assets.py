@@ -10,7 +10,8 @@ from pathlib import Path
 
 from ar3cli.errors import UserError
 
-_PACKAGE_DIR = Path(__file__).resolve().parent
+_PACKAGE_DIR = Path(__file__).resolve().parents[1]
+"""The ar3cli package folder (this module sits in its infra/ package)."""
 
 
 def assets_dir() -> Path:

@@ -9,7 +9,7 @@ lock with what other ar3cli processes saved meanwhile (pre-commit runs several a
 or unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
 ``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
 
-A forked worker process (:mod:`ar3cli.process_pool`) never saves: it hands what it learnt to its
+A forked worker process (:mod:`ar3cli.infra.process_pool`) never saves: it hands what it learnt to its
 parent (:func:`take_learned`), which merges it (:func:`merge_learned`) and saves once.
 """
 
@@ -124,7 +124,7 @@ class FileFacts:
         if not self._dirty or location is None:
             return
         try:
-            from ar3cli.atomic import atomic_write
+            from ar3cli.infra.atomic import atomic_write
 
             location.parent.mkdir(parents=True, exist_ok=True)
             with _locked(location.with_name(location.name + ".lock")):
@@ -144,7 +144,7 @@ def _read_entries(location: Path) -> dict[str, Any]:
     """The cache file's entries; {} when there is none, or a damaged one (junk, JSON nested
     thousands deep, a pipe in its place: read like a robot file, regular files only)."""
     from ar3cli.errors import UserError
-    from ar3cli.xmlsource import read_bytes
+    from ar3cli.urdf.xmlsource import read_bytes
 
     try:
         loaded = json.loads(read_bytes(location))

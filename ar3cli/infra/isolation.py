@@ -24,7 +24,7 @@ from collections.abc import Callable
 from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import EXIT_USAGE, UserError
-from ar3cli.process_pool import can_fork, sigint_deferred, stop_children
+from ar3cli.infra.process_pool import can_fork, sigint_deferred, stop_children
 
 Result = TypeVar("Result")
 

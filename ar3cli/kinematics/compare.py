@@ -1,8 +1,8 @@
 """PyBullet's link frames against the independent URDF forward kinematics.
 
 The configurations are set in PyBullet (``resetJointState``) and the *link frames* are read
-(``getLinkState(...)[4:6]``, via :meth:`ar3cli.sim.Body.link_frames`), then the same frames are
-computed by :func:`ar3cli.kinematics.urdf_link_frames` from the Model. Differences that real
+(``getLinkState(...)[4:6]``, via :meth:`ar3cli.sim.session.Body.link_frames`), then the same frames are
+computed by :func:`ar3cli.kinematics.fk.urdf_link_frames` from the Model. Differences that real
 models produce are explained by :func:`model_notes`: mimic joints (pybullet does not couple them, so
 we set the mimic joint's value ourselves), non-unit axes (pybullet normalises revolute axes but
 moves prismatic joints by ``|axis| * q``), and the base pose being the COM in pybullet.
@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ar3cli import kinematics
+from ar3cli.kinematics import fk as kinematics
 from ar3cli.errors import UserError
-from ar3cli.model import Model
+from ar3cli.urdf.model import Model
 
 
 @dataclass
@@ -64,11 +64,11 @@ class Comparison:
 
 
 def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
-    """Uniform samples of the driving joints (:mod:`ar3cli.sampling`); mimic joints follow.
+    """Uniform samples of the driving joints (:mod:`ar3cli.sim.sampling`); mimic joints follow.
 
-    Ranges come from :meth:`ar3cli.sim.JointRecord.sample_range`, i.e. the URDF's limits.
+    Ranges come from :meth:`ar3cli.sim.session.JointRecord.sample_range`, i.e. the URDF's limits.
     """
-    from ar3cli import sampling
+    from ar3cli.sim import sampling
 
     space = sampling.joint_space(body)
     values = sampling.sample_driving(space, count, seed)
@@ -78,7 +78,7 @@ def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
 
 
 def body_configurations(body, samples: Samples) -> np.ndarray:
-    """(N, movable joints) values in :attr:`~ar3cli.sim.Body.movable_joints` order, mimic joints included."""
+    """(N, movable joints) values in :attr:`~ar3cli.sim.session.Body.movable_joints` order, mimic joints included."""
     names = [joint.name for joint in body.movable_joints]
     if not names:
         return np.zeros((samples.count, 0))

@@ -27,10 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from ar3cli import kinematics
+from ar3cli.kinematics import fk as kinematics
 from ar3cli.errors import UserError
-from ar3cli.kinematics import DHRow
-from ar3cli.model import Joint, Model
+from ar3cli.kinematics.fk import DHRow
+from ar3cli.urdf.model import Joint, Model
 
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 ANGLE_UNITS = {"rad": 1.0, "deg": math.pi / 180.0}
@@ -87,7 +87,7 @@ class DHTable:
 
 def load_dh(path: Path, model: Model) -> DHTable:
     """Read and validate a DH YAML file against ``model``; every problem is a one-line UserError."""
-    from ar3cli.yamlfile import load_yaml
+    from ar3cli.urdf.yamlfile import load_yaml
 
     where = str(path)
     document = load_yaml(path, "DH file")

@@ -2,7 +2,7 @@
 
 Two ways to place frames, both batched over N configurations (arrays of shape ``(N, 4, 4)``):
 
-- :func:`urdf_link_frames` walks the URDF tree of a :class:`~ar3cli.model.Model` the way the URDF
+- :func:`urdf_link_frames` walks the URDF tree of a :class:`~ar3cli.urdf.model.Model` the way the URDF
   spec says: joint origin (xyz, then rpy as ``Rz(yaw) Ry(pitch) Rx(roll)``), then the motion about
   the **normalised** axis (rotation for revolute/continuous, translation for prismatic); mimic
   joints take ``multiplier * q[mimicked] + offset``.
@@ -23,8 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ar3cli.errors import UserError
-from ar3cli.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
-from ar3cli.model import ACTUATED_JOINT_TYPES, ROTATING_JOINT_TYPES, Joint, Model
+from ar3cli.physics.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
+from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, ROTATING_JOINT_TYPES, Joint, Model
 
 SUPPORTED_TYPES = (*ACTUATED_JOINT_TYPES, "fixed")
 """Joint types the URDF forward kinematics here can place (not planar, floating or spherical)."""

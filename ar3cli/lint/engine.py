@@ -2,10 +2,10 @@
 
 One file's trouble never stops the run: a file that cannot be read, parsed or expanded becomes a
 finding of the F family on that file (:func:`load_failure`) and the engine moves on. Rules yield
-:class:`~ar3cli.rules.base.Hit` objects; this module turns them into located
+:class:`~ar3cli.lint.rules.base.Hit` objects; this module turns them into located
 :class:`~ar3cli.findings.Finding` objects, drops the suppressed ones (inline comments,
 ``per-file-ignores``) and applies severity overrides. Nothing here imports pybullet: ``--sim`` rules
-open a :class:`~ar3cli.sim.Session` lazily through :attr:`Context.session`.
+open a :class:`~ar3cli.sim.session.Session` lazily through :attr:`Context.session`.
 """
 
 from __future__ import annotations
@@ -19,13 +19,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ar3cli.cache import cache_dir, merge_learned, take_learned
+from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
-from ar3cli.rules import REGISTRY, RULES, Hit, Rule, matches
+from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
 
 if TYPE_CHECKING:
-    from ar3cli.lint_cache import ResultCache
+    from ar3cli.lint.result_cache import ResultCache
 
 ROBOT_SUFFIXES = (".urdf", ".xacro")
 _SKIP_DIRS = {".git", ".hg", ".svn", "__pycache__", "node_modules", ".venv", "venv", ".tox"}
@@ -77,7 +77,7 @@ class Context:
     def link_bounds(self, link):
         """Box around the link's collision (else visual) shapes in its frame, or None."""
         if link.name not in self._bounds:
-            from ar3cli.rules.geometry import link_bounds
+            from ar3cli.lint.rules.geometry import link_bounds
 
             self._bounds[link.name] = link_bounds(link)
         return self._bounds[link.name]
@@ -86,7 +86,7 @@ class Context:
     def session(self):
         """A PyBullet session for ``--sim`` rules, opened on first use (pybullet is imported only then)."""
         if self._session is None:
-            from ar3cli.sim import Session
+            from ar3cli.sim.session import Session
 
             self._session = Session(gravity=-9.81, file_caching=True)
         return self._session
@@ -141,11 +141,11 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
                jobs: int | None = None) -> list[FileResult]:
     """Lint every file under ``paths``; one :class:`FileResult` per file, in order.
 
-    With ``use_cache``, unchanged files reuse the findings of an earlier run (:mod:`ar3cli.lint_cache`).
+    With ``use_cache``, unchanged files reuse the findings of an earlier run (:mod:`ar3cli.lint.result_cache`).
     ``jobs`` processes share the files (None: one per CPU for large batches, see
-    :func:`~ar3cli.process_pool.worker_count`); the results do not depend on it.
+    :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it.
     """
-    from ar3cli.process_pool import map_in_processes, worker_count
+    from ar3cli.infra.process_pool import map_in_processes, worker_count
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
@@ -174,7 +174,7 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
     """The result cache for these settings, or None when caching is off or cannot apply (``--sim``)."""
     if options.sim or cache_dir() is None:
         return None
-    from ar3cli.lint_cache import ResultCache
+    from ar3cli.lint.result_cache import ResultCache
 
     return ResultCache.for_settings(rules=[rule.code for rule in rules], per_file_ignores=options.per_file_ignores,
                                     severity=options.severity, package_paths=options.package_paths,
@@ -184,11 +184,11 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
 def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: ResultCache | None = None) -> FileResult:
     """Load one file and run ``rules`` on it; a load failure is a finding, never an exception.
 
-    ``cache`` (a :class:`~ar3cli.lint_cache.ResultCache`) answers for unchanged ``.urdf`` files
+    ``cache`` (a :class:`~ar3cli.lint.result_cache.ResultCache`) answers for unchanged ``.urdf`` files
     and learns the findings of the others.
     """
-    from ar3cli.model import load_model
-    from ar3cli.xacro_expand import is_xacro
+    from ar3cli.urdf.model import load_model
+    from ar3cli.urdf.xacro_expand import is_xacro
 
     shown = display_path(path)
     if cache is not None and not is_xacro(path):
@@ -216,7 +216,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
 def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> FileResult:
     """Run ``rules`` on a loaded model and apply suppressions and severity overrides.
 
-    The simulation rules run in a forked child (:func:`~ar3cli.isolation.run_isolated`): when
+    The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
     static = [rule for rule in rules if not rule.needs_sim]
@@ -224,8 +224,8 @@ def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> F
     findings = _run_rules(model, shown, static, options)
     error = None
     if simulated:
-        from ar3cli.isolation import CrashError
-        from ar3cli.sim import run_pybullet
+        from ar3cli.infra.isolation import CrashError
+        from ar3cli.sim.session import run_pybullet
 
         try:
             findings += run_pybullet(lambda: _run_rules(model, shown, simulated, options), model)
@@ -298,7 +298,7 @@ class Locator:
 
     def _xacro_position(self, element) -> tuple[int, int]:
         """Position of the enclosing link/joint (by its name) in the xacro source; (0, 0) if ambiguous."""
-        from ar3cli.xmlsource import decode_text
+        from ar3cli.urdf.xmlsource import decode_text
 
         if self._source_text is None:
             self._source_text = decode_text(self.model.source_bytes)

@@ -18,7 +18,7 @@ and reuses them while nothing they depend on has changed:
 Only static lints of ``.urdf`` files that loaded are remembered: xacro expansion reads includes
 that ar3cli does not see, and ``--sim`` results depend on PyBullet. ``--no-cache`` or
 ``AR3CLI_NO_CACHE=1`` turn it off; the store is ``<cache dir>/lint-results-v1.json``
-(:mod:`ar3cli.cache`).
+(:mod:`ar3cli.infra.file_cache`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ar3cli import __version__
-from ar3cli.cache import MISSING, PathState, file_facts, path_state
+from ar3cli.infra.file_cache import MISSING, PathState, file_facts, path_state
 from ar3cli.findings import Finding, Severity
 
 MAX_RESULTS = 2_000
@@ -38,7 +38,8 @@ MAX_RESULTS = 2_000
 store (0.5 to 2.5 kB a file: pybullet_data's 1101 files make 0.5 MB, read in ~4 ms)."""
 
 _STORE = file_facts("lint-results", version=1, max_entries=MAX_RESULTS)
-_PACKAGE_DIR = Path(__file__).resolve().parent
+_PACKAGE_DIR = Path(__file__).resolve().parents[1]
+"""The whole ar3cli package (every module of it may change a finding)."""
 _ENVIRONMENT = ("ROS_PACKAGE_PATH", "AMENT_PREFIX_PATH")
 
 
@@ -137,7 +138,7 @@ def _finding(shown: str, rule, severity, message, line, column, hint) -> Finding
 def _read(path: Path) -> bytes | None:
     """The file's bytes as the loader would read them (same size limit), or None."""
     from ar3cli.errors import UserError
-    from ar3cli.xmlsource import read_bytes
+    from ar3cli.urdf.xmlsource import read_bytes
 
     try:
         return read_bytes(path)

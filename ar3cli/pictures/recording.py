@@ -15,7 +15,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ar3cli.atomic import atomic_write
+from ar3cli.infra.atomic import atomic_write
 from ar3cli.errors import UserError
 
 

@@ -3,7 +3,7 @@
 The camera frames the robot's bounding box at the chosen configuration. Optionally the collision
 geometry is drawn (in blue, in place of the visual geometry: TinyRenderer has no transparency, so a
 true overlay z-fights with the visual surfaces it coincides with), and links that interpenetrate a
-link they are not adjacent to are drawn red, by :func:`ar3cli.adjacency.nonadjacent_collisions`:
+link they are not adjacent to are drawn red, by :func:`ar3cli.sim.adjacency.nonadjacent_collisions`:
 at the home pose the picture shows exactly what ``lint-urdf --sim`` (P002) and sample-collisions
 ("default") report.
 """
@@ -18,9 +18,9 @@ from dataclasses import dataclass, field
 from typing import Any
 from pathlib import Path
 
-from ar3cli.atomic import atomic_write
+from ar3cli.infra.atomic import atomic_write
 from ar3cli.errors import UserError
-from ar3cli.model import Model
+from ar3cli.urdf.model import Model
 
 CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
 COLLISION_RGBA = "0.15 0.55 0.95 1"
@@ -85,7 +85,7 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
     """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``."""
     from PIL import Image
 
-    from ar3cli.sim import run_pybullet
+    from ar3cli.sim.session import run_pybullet
 
     if not 16 <= width <= 4096 or not 16 <= height <= 4096:
         raise UserError(f"image size {width}x{height} is out of range (16..4096 pixels per side)")
@@ -107,9 +107,9 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
 def _draw(model: Model, configuration: Mapping[str, float], width: int, height: int, yaw_deg: float,
           pitch_deg: float, show_collision: bool, show_contacts: bool) -> tuple[Any, dict[str, float], list]:
     """In pybullet: the RGB picture, the joint values drawn, and the links in contact (drawn red)."""
-    from ar3cli.adjacency import nonadjacent_collisions
-    from ar3cli.isolation import report_stage
-    from ar3cli.sim import SELF_COLLISION_ALL_PAIRS, Session
+    from ar3cli.sim.adjacency import nonadjacent_collisions
+    from ar3cli.infra.isolation import report_stage
+    from ar3cli.sim.session import SELF_COLLISION_ALL_PAIRS, Session
 
     with Session() as session:
         drawn = showing_collision_geometry(model) if show_collision else model
@@ -139,7 +139,7 @@ def configuration_with_mimics(body, configuration: Mapping[str, float]) -> dict[
     joints following their source unless given explicitly (a robot cannot be in any other state)."""
     import numpy as np
 
-    from ar3cli.sampling import joint_space
+    from ar3cli.sim.sampling import joint_space
 
     space = joint_space(body)
     driving = [configuration.get(name, space.home[index]) for index, name in zip(space.driving, space.driving_names)]

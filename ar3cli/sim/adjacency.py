@@ -8,7 +8,7 @@ interpenetrating?". They use the same two definitions, from here:
   (removed, their neighbours joined). pybullet_data's panda_link7 and panda_hand are adjacent
   through the geometry-less panda_link8: a URDF cannot put geometry between them, so their
   overlap is by construction, not a modelling error.
-- **Colliding** is penetrating deeper than :data:`ar3cli.sim.PENETRATION_TOLERANCE` (1 um):
+- **Colliding** is penetrating deeper than :data:`ar3cli.sim.session.PENETRATION_TOLERANCE` (1 um):
   resting faces (depth ~1e-16 m) and points at a positive distance do not count.
 
 :func:`direct_parent_child` is something else: the pairs PyBullet's ``URDF_USE_SELF_COLLISION``
@@ -20,7 +20,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from ar3cli.model import Model
+from ar3cli.urdf.model import Model
 
 
 def collision_links(model: Model) -> list[str]:
@@ -69,7 +69,7 @@ def nonadjacent_collisions(body: Any, model: Model | None = None) -> list[tuple[
     ``body`` must be loaded with ``self_collision="all-pairs"``; ``model`` (default
     ``body.model``) gives the adjacency. Returns (link_a, link_b, depth in m, negative).
     """
-    from ar3cli.sim import PENETRATION_TOLERANCE
+    from ar3cli.sim.session import PENETRATION_TOLERANCE
 
     adjacent = adjacent_pairs(model or body.model)
     return [(a, b, depth) for a, b, depth in body.contacts(min_depth=PENETRATION_TOLERANCE)

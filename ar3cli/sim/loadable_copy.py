@@ -25,7 +25,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
-from ar3cli.model import Model
+from ar3cli.urdf.model import Model
 
 
 def loadable_document(model: Model) -> bytes:

@@ -1,19 +1,19 @@
 """Joint-space sampling shared by sample-collisions and fk-verify.
 
-A configuration is one value per 1-DOF joint of a loaded :class:`~ar3cli.sim.Body`, in
-:attr:`~ar3cli.sim.Body.movable_joints` order (what :meth:`~ar3cli.sim.Body.set_positions` and
+A configuration is one value per 1-DOF joint of a loaded :class:`~ar3cli.sim.session.Body`, in
+:attr:`~ar3cli.sim.session.Body.movable_joints` order (what :meth:`~ar3cli.sim.session.Body.set_positions` and
 ``resetJointStatesMultiDof`` take). Only the *driving* joints are free: a joint with a
 ``<mimic>`` of an existing joint is computed from its source (``multiplier * q + offset``, chains
-followed, by :func:`ar3cli.kinematics.driven_values`), because PyBullet does not couple mimic
+followed, by :func:`ar3cli.kinematics.fk.driven_values`), because PyBullet does not couple mimic
 joints and a configuration with the two fingers of a gripper at unrelated positions is one the
 robot can never reach.
 
-- Ranges: :meth:`~ar3cli.sim.JointRecord.sample_range` (the URDF limits; continuous and unlimited
+- Ranges: :meth:`~ar3cli.sim.session.JointRecord.sample_range` (the URDF limits; continuous and unlimited
   revolute joints in [-pi, pi)).
 - Uniform samples: ``numpy.random.default_rng(seed).uniform(lower, upper, size=(N, driving))``,
   the driving joints in body order. Without mimic joints that is exactly the draw both commands
   made before this module existed, so a seed gives the same configurations as before.
-- Home: :meth:`~ar3cli.sim.JointRecord.home` for each driving joint (0, or mid-range where 0 is
+- Home: :meth:`~ar3cli.sim.session.JointRecord.home` for each driving joint (0, or mid-range where 0 is
   outside the limits), mimic joints following.
 - Limit configurations: the home pose, each limited driving joint at its lower and at its upper
   limit (the others at home), all limited driving joints at lower, all at upper; mimic joints
@@ -27,9 +27,9 @@ from typing import Any
 
 import numpy as np
 
-from ar3cli import kinematics
+from ar3cli.kinematics import fk as kinematics
 from ar3cli.errors import UserError
-from ar3cli.model import Model
+from ar3cli.urdf.model import Model
 
 
 @dataclass(frozen=True)
@@ -83,12 +83,12 @@ class JointSpace:
 
 
 def is_mimic(joint: Any, model: Model) -> bool:
-    """A :class:`~ar3cli.sim.JointRecord` whose URDF joint mimics a joint that exists."""
+    """A :class:`~ar3cli.sim.session.JointRecord` whose URDF joint mimics a joint that exists."""
     return joint.urdf is not None and joint.urdf.mimic is not None and model.joint(joint.urdf.mimic.joint) is not None
 
 
 def joint_space(body: Any) -> JointSpace:
-    """The joint space of a loaded :class:`~ar3cli.sim.Body` (its ``model`` gives the mimic couplings)."""
+    """The joint space of a loaded :class:`~ar3cli.sim.session.Body` (its ``model`` gives the mimic couplings)."""
     joints = body.movable_joints
     driving = tuple(i for i, joint in enumerate(joints) if not is_mimic(joint, body.model))
     ranges = np.array([joints[i].sample_range() for i in driving], dtype=float).reshape(-1, 2)

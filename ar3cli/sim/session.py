@@ -8,7 +8,7 @@ collision filters, ...) through ``session.p``, always with ``physicsClientId=ses
 
 Everything here follows measured behaviour (``shared/docs/pybullet-facts.md``), not tutorials:
 
-- pybullet is imported and used inside :func:`~ar3cli.capture.capture_fds`, so nothing it prints
+- pybullet is imported and used inside :func:`~ar3cli.sim.capture.capture_fds`, so nothing it prints
   from C reaches stdout; what it says is kept in :attr:`Session.messages`.
 - File caching is off by default (pybullet caches files by name for the whole session, so a URDF
   rewritten by a fixer would otherwise load with its OLD content), and every load gets a fresh file
@@ -37,10 +37,10 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ar3cli.capture import capture_fds
+from ar3cli.sim.capture import capture_fds
 from ar3cli.errors import UserError
-from ar3cli.isolation import report_stage
-from ar3cli.model import ACTUATED_JOINT_TYPES, Joint, Model
+from ar3cli.infra.isolation import report_stage
+from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 Result = TypeVar("Result")
 Pose = tuple[tuple[float, float, float], tuple[float, float, float, float]]
@@ -90,7 +90,7 @@ class JointRecord:
 
     @property
     def movable(self) -> bool:
-        """A 1-DOF joint (:data:`~ar3cli.model.ACTUATED_JOINT_TYPES`): one position, one motor."""
+        """A 1-DOF joint (:data:`~ar3cli.urdf.model.ACTUATED_JOINT_TYPES`): one position, one motor."""
         return self.urdf_type in ACTUATED_JOINT_TYPES
 
     @property
@@ -364,8 +364,8 @@ class Session:
         return body
 
     def _write_loadable_copy(self, model: Model) -> Path:
-        """Write the copy pybullet loads (:mod:`ar3cli.loadable_copy`) under a fresh name."""
-        from ar3cli.loadable_copy import write_loadable_copy
+        """Write the copy pybullet loads (:mod:`ar3cli.sim.loadable_copy`) under a fresh name."""
+        from ar3cli.sim.loadable_copy import write_loadable_copy
 
         name = f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
         return write_loadable_copy(model, Path(self._tmp.name) / name)
@@ -397,9 +397,9 @@ def refuse_what_crashes_pybullet(model: Model) -> None:
 
 def run_pybullet(work: Callable[[], Result], model: Model) -> Result:
     """``work()`` (pybullet work on ``model``) in a forked child: a crash in pybullet's C code becomes
-    a one-line :class:`~ar3cli.isolation.CrashError` (exit 2) naming the file, what pybullet was
+    a one-line :class:`~ar3cli.infra.isolation.CrashError` (exit 2) naming the file, what pybullet was
     doing, and the element known to cause it, instead of killing ar3cli."""
-    from ar3cli.isolation import run_isolated
+    from ar3cli.infra.isolation import run_isolated
 
     return run_isolated(work, str(model.path), cause=lambda: known_crash_cause(model))
 

@@ -6,7 +6,7 @@ files, 52k vertices, take ~25 ms), so a static lint never imports either for the
 files of at least :data:`NUMPY_MIN_BYTES` are read with numpy, where its import pays for
 itself. Other formats (COLLADA .dae, ...) fall back to trimesh, imported only then. Results are
 cached per path for the process (bulk lints share meshes between models) and on disk between runs
-(:mod:`ar3cli.cache`, keyed by path, modification time and size).
+(:mod:`ar3cli.infra.file_cache`, keyed by path, modification time and size).
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
 
-from ar3cli.cache import MISSING, file_facts
+from ar3cli.infra.file_cache import MISSING, file_facts
 
 LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 LFS_POINTER_MAX_BYTES = 1024

@@ -2,7 +2,7 @@
 
 The Model keeps the parsed lxml tree (each element knows its source line), typed views of links,
 joints, inertials and geometry, mesh URIs resolved to paths (with the places tried), and the
-:class:`~ar3cli.xmlsource.Quirk` list of everything odd about the file. Values that do not parse
+:class:`~ar3cli.urdf.xmlsource.Quirk` list of everything odd about the file. Values that do not parse
 are kept as ``None`` next to their raw text, so the linter can report them while the other
 commands still load the file. Nothing here imports pybullet, trimesh or yourdfpy.
 """
@@ -16,10 +16,11 @@ from functools import cached_property, lru_cache
 from pathlib import Path
 from typing import Any
 
-from ar3cli import xacro_expand, xmlsource
+from ar3cli.urdf import xacro_expand
+from ar3cli.urdf import xmlsource
 from ar3cli.errors import UserError
-from ar3cli.packages import PackageResolver, Resolution
-from ar3cli.xmlsource import Quirk
+from ar3cli.urdf.packages import PackageResolver, Resolution
+from ar3cli.urdf.xmlsource import Quirk
 
 Vec3 = tuple[float, float, float]
 ROTATING_JOINT_TYPES = ("revolute", "continuous")

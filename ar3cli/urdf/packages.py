@@ -24,7 +24,7 @@ from functools import lru_cache
 from pathlib import Path
 from urllib.parse import unquote
 
-from ar3cli.cache import PathState, path_state
+from ar3cli.infra.file_cache import PathState, path_state
 
 _PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
 

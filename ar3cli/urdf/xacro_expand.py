@@ -1,7 +1,7 @@
 """Expand ``.xacro`` files in-process with the ``xacro`` package.
 
 No ROS installation is needed: ``$(find NAME)`` is answered by the same
-:class:`~ar3cli.packages.PackageResolver` that resolves ``package://`` URIs, and ``$(arg ...)``
+:class:`~ar3cli.urdf.packages.PackageResolver` that resolves ``package://`` URIs, and ``$(arg ...)``
 values come from ``--xacro-arg NAME:=VALUE``. Whatever goes wrong inside xacro becomes a one-line
 :class:`~ar3cli.errors.UserError` naming the file.
 """
@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.packages import PackageResolver
+from ar3cli.urdf.packages import PackageResolver
 
 
 def is_xacro(path: Path) -> bool:

@@ -3,13 +3,13 @@
 Codes are grouped by family prefix (F file, S structure, J joints, I inertia, G geometry,
 P simulation) and never reused. To add a rule: write one decorated function in its family module
 and add it to that module's ``RULES`` tuple; docs/rules.md is generated from this registry
-(``python -m ar3cli.rules.docs > docs/rules.md``) and a test keeps the two equal.
+(``python -m ar3cli.lint.rules.docs > docs/rules.md``) and a test keeps the two equal.
 """
 
 from __future__ import annotations
 
-from ar3cli.rules import file, geometry, inertia, joints, sim, structure
-from ar3cli.rules.base import FAMILIES, Hit, Rule
+from ar3cli.lint.rules import file, geometry, inertia, joints, sim, structure
+from ar3cli.lint.rules.base import FAMILIES, Hit, Rule
 
 RULES: tuple[Rule, ...] = (*file.RULES, *structure.RULES, *joints.RULES, *inertia.RULES, *geometry.RULES,
                            *sim.RULES)

@@ -3,7 +3,7 @@
 A rule is a generator function ``check(ctx) -> Iterator[Hit]`` plus its metadata (stable code,
 severity, title, documentation with a failing and a passing example). Rules never build
 :class:`~ar3cli.findings.Finding` objects themselves: they yield a :class:`Hit` naming the
-element at fault, and the engine (:mod:`ar3cli.lint`) turns it into a Finding with path, line,
+element at fault, and the engine (:mod:`ar3cli.lint.engine`) turns it into a Finding with path, line,
 column, suppression and configured severity. That keeps each rule a few lines of logic.
 """
 
@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from ar3cli.findings import Severity
 
 if TYPE_CHECKING:
-    from ar3cli.lint import Context
+    from ar3cli.lint.engine import Context
 
 FAMILIES = {
     "F": "file",

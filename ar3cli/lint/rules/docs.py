@@ -1,12 +1,12 @@
-"""Generate docs/rules.md from the registry: ``python -m ar3cli.rules.docs > docs/rules.md``."""
+"""Generate docs/rules.md from the registry: ``python -m ar3cli.lint.rules.docs > docs/rules.md``."""
 
 from __future__ import annotations
 
-from ar3cli.rules import FAMILIES, RULES
+from ar3cli.lint.rules import FAMILIES, RULES
 
 HEADER = """# ar3cli lint-urdf rules
 
-Generated from the rule registry by `python -m ar3cli.rules.docs > docs/rules.md`; a test fails
+Generated from the rule registry by `python -m ar3cli.lint.rules.docs > docs/rules.md`; a test fails
 when this file and the registry differ. Every example below is linted by the test suite: the
 failing example must trigger its rule and the passing one must not.
 

@@ -7,7 +7,7 @@ import re
 from collections.abc import Iterator
 from functools import lru_cache
 
-from ar3cli.rules.base import Hit, engine_rule, robot, rule
+from ar3cli.lint.rules.base import Hit, engine_rule, robot, rule
 
 unreadable = engine_rule(
     "F001", "unreadable", "error", "File cannot be read",

@@ -6,8 +6,8 @@ import math
 from collections.abc import Iterator
 from pathlib import Path
 
-from ar3cli.rules.base import LINK_INERTIAL, Hit, robot, rule
-from ar3cli.tensor_math import rpy_to_matrix
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
+from ar3cli.physics.tensor_math import rpy_to_matrix
 
 Vector = tuple[float, float, float]
 Box = tuple[Vector, Vector]
@@ -59,7 +59,7 @@ def shape_bounds(shape) -> Box | None:
 
 def scaled_mesh_bounds(geometry) -> Box | None:
     """The mesh's box in the shape frame (file bounds times scale), or None when it cannot be read."""
-    from ar3cli.meshinfo import mesh_bounds
+    from ar3cli.urdf.meshinfo import mesh_bounds
 
     resolution = geometry.resolution
     scale = geometry.params.get("scale")
@@ -160,7 +160,7 @@ def mesh_format(ctx) -> Iterator[Hit]:
       fix="Run git lfs install && git lfs pull in the repository.",
       bad=_mesh_robot("meshes/base.stl"), good=_mesh_robot("meshes/base.stl"))
 def lfs_pointer(ctx) -> Iterator[Hit]:
-    from ar3cli.meshinfo import is_lfs_pointer
+    from ar3cli.urdf.meshinfo import is_lfs_pointer
 
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution

@@ -1,6 +1,6 @@
 """Simulation rules (P, only with ``--sim``): load the model in PyBullet and see what it really does.
 
-Each rule loads the model in the file's shared :class:`~ar3cli.sim.Session` (``ctx.session``,
+Each rule loads the model in the file's shared :class:`~ar3cli.sim.session.Session` (``ctx.session``,
 gravity -9.81 m/s^2), checks one thing and removes the body again, so the rules are independent of
 each other.
 """
@@ -12,7 +12,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 from ar3cli.errors import UserError
-from ar3cli.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 
 INERTIA_TOLERANCE = 0.10
 """Relative difference between the file and PyBullet's value above which P003 reports a link."""
@@ -37,7 +37,7 @@ def _loaded(ctx, **load_options):
 
 
 def _home(body) -> dict[str, float]:
-    from ar3cli.sampling import home_positions
+    from ar3cli.sim.sampling import home_positions
 
     return home_positions(body)
 
@@ -81,7 +81,7 @@ def _stacked_boxes(tip_z: float) -> str:
       bad=_stacked_boxes(tip_z=-0.25), good=_stacked_boxes(tip_z=0.25),
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
-    from ar3cli.adjacency import nonadjacent_collisions
+    from ar3cli.sim.adjacency import nonadjacent_collisions
 
     with _loaded(ctx, self_collision="all-pairs") as body:
         if body is None:
@@ -112,7 +112,7 @@ def sim_inertia_differs(ctx) -> Iterator[Hit]:
 
     A per-link finding would bury a clean model in rows: the default load replaces *every* tensor.
     """
-    from ar3cli.rules.inertia import finite_tensor, tensor_moments
+    from ar3cli.lint.rules.inertia import finite_tensor, tensor_moments
 
     changed: list[tuple[float, str, object]] = []  # (relative difference, description, element)
     with _loaded(ctx, fixed_base=False, flags=ctx.session.p.URDF_MAINTAIN_LINK_ORDER) as body:
