@@ -12,7 +12,8 @@ from tests.conftest import ASSETS
 from tests.fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write
 
 from ar3cli.physics import mass_properties as mp
-from ar3cli.fix.geometry_mass import capsule, links_needing_inertia
+from ar3cli.fix.geometry_mass import capsule
+from ar3cli.fix.inertia_plan import links_needing_inertia
 from ar3cli.urdf.model import load_model
 
 KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")

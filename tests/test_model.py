@@ -133,9 +133,9 @@ def test_directory_is_refused(tmp_path):
 
 
 def test_size_cap(tmp_path, monkeypatch):
-    from ar3cli.urdf import xmlsource
+    from ar3cli.infra import safe_read
 
-    monkeypatch.setattr(xmlsource, "MAX_FILE_BYTES", 100)
+    monkeypatch.setattr(safe_read, "MAX_FILE_BYTES", 100)
     path = _write(tmp_path / "big.urdf", ARM.encode())
     with pytest.raises(UserError, match="larger than"):
         load_model(path)

@@ -7,8 +7,9 @@ import typer
 
 from ar3cli.errors import UserError
 from ar3cli.commands.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
-                            load_from_options, samples_option)
+                            samples_option)
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
+from ar3cli.urdf.loading import load_with_specs
 
 SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
@@ -44,7 +45,7 @@ def fk_verify(
 
     if not (tolerance_m > 0 and tolerance_rad > 0):
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
-    model = load_from_options(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg)
     table = dh_module.load_dh(dh, model) if dh is not None else None
 
     def measure() -> tuple[fk_compare.Samples, fk_compare.Comparison]:

@@ -42,17 +42,3 @@ CheckOption = Annotated[bool, typer.Option("--check", help="Write nothing; exit 
 OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_default=False,
                                                       help="Write the result to FILE instead of in place "
                                                            "(one input only).")]
-
-
-def load_from_options(path: Path, package_path: list[str] | None, xacro_arg: list[str] | None):
-    """Parse the shared loading options and load the model; malformed options raise UserError."""
-    from ar3cli.urdf.model import load_model
-    from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
-
-    try:
-        packages = parse_package_paths(package_path)
-        xacro_args = parse_xacro_args(xacro_arg)
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
-    return load_model(path, packages, xacro_args)

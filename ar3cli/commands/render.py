@@ -5,8 +5,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, load_from_options
+from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
 from ar3cli.output.report import OutputFormat, Report, Table, finish
+from ar3cli.urdf.loading import load_with_specs
 
 
 def render_command(
@@ -35,7 +36,7 @@ def render_command(
     from ar3cli.pictures.render import render as draw
 
     configuration = parse_configuration(config)
-    model = load_from_options(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg)
     result = draw(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
                   show_collision=collision)
     tables = []

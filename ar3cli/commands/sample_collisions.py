@@ -96,9 +96,9 @@ def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | 
 
 
 def _load(path, package_path, xacro_arg):
-    from ar3cli.commands.options import load_from_options
+    from ar3cli.urdf.loading import load_with_specs
 
-    return load_from_options(path, package_path, xacro_arg)
+    return load_with_specs(path, package_path, xacro_arg)
 
 
 def _source(model, package_path, xacro_arg):

@@ -102,8 +102,9 @@ def refuse_xacro(paths: list[Path]) -> None:
     for path in paths:
         if is_xacro(path):
             raise UserError(f"{path}: is a xacro file; fixing the generated URDF would not fix the source. "
-                            "Fix the .xacro by hand (the expanded-URDF output of this command with --diff shows "
-                            "what to change), or run this command on a URDF")
+                            f"To see what to change in the .xacro, expand it (xacro {path.name} > robot.urdf) "
+                            "and run this command on robot.urdf with --diff; 'ar3cli lint-urdf' reads the "
+                            ".xacro directly")
 
 
 def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, check: bool, output: Path | None,
@@ -113,7 +114,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     Every file is loaded and planned before the first write: a bad second input stops the run
     with no file changed, instead of after the first one was rewritten.
     """
-    from ar3cli.commands.options import load_from_options
+    from ar3cli.urdf.loading import load_with_specs
 
     if not paths:
         raise UserError("give at least one file")
@@ -122,7 +123,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     refuse_xacro(paths)
     planned: list[tuple[FileResult, bytes]] = []
     for path in paths:
-        model = load_from_options(path, package_path, None)
+        model = load_with_specs(path, package_path, None)
         document = Document(model.source_bytes)
         document.bind(model.root)
         plan = fixer(model, document)
@@ -141,7 +142,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
         target = output or result.path
         if not diff and not check and (result.changed or output is not None):
             def validate(temp: Path, result: FileResult = result) -> None:
-                new_model = load_from_options(temp, package_path, None)
+                new_model = load_with_specs(temp, package_path, None)
                 if verifier is not None and result.plan.changes:
                     result.verification = verifier(new_model, result.plan)
 

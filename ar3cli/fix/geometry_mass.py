@@ -1,4 +1,4 @@
-"""Mass properties of a link from its geometry, and which links need new ones.
+"""Mass properties of a link from its geometry.
 
 Primitives use :mod:`ar3cli.physics.mass_properties` (exact, analytic). Meshes use trimesh: scale
 applied, exact signed-tetrahedra volume when the mesh is watertight, otherwise its convex hull
@@ -193,33 +193,3 @@ def is_frame_link(model: Model, link: Link) -> bool:
     """A pure frame (tool0, flange, tcp): no geometry, attached to its parent by a fixed joint."""
     joint = model.parent_joint(link.name)
     return not link.has_geometry and joint is not None and joint.type == "fixed"
-
-
-def links_needing_inertia(model: Model) -> dict[str, str]:
-    """``{link name: "CODE name: message"}`` for every link the lint inertia rules (I001-I007) flag.
-
-    The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
-    so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
-    """
-    from ar3cli.lint.engine import Context, LintOptions, suppressed_inline
-    from ar3cli.lint.rules.inertia import RULES
-
-    context = Context(model, LintOptions())
-    found: dict[str, str] = {}
-    try:
-        for rule in RULES:
-            for hit in rule.check(context):
-                element = _owning_link(hit.element)
-                if element is None or suppressed_inline(hit.element, rule.code):
-                    continue
-                found.setdefault(element.get("name", ""), f"{rule.code} {rule.name}: {hit.message}")
-    finally:
-        context.close()
-    return {link.name: found[link.name] for link in model.links if link.name in found}
-
-
-def _owning_link(element):
-    """The ``<link>`` element a hit's element belongs to (itself, or an ancestor)."""
-    while element is not None and element.tag != "link":
-        element = element.getparent()
-    return element

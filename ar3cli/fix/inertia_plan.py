@@ -25,6 +25,7 @@ from dataclasses import asdict, dataclass, field
 import numpy as np
 
 from ar3cli.fix import geometry_mass as inertia
+from ar3cli.urdf.model import Model
 from ar3cli.physics import mass_properties as mp
 from ar3cli.fix.edits import Document
 from ar3cli.errors import UserError
@@ -102,7 +103,7 @@ def _select(model, options: InertiaOptions) -> tuple[dict[str, str], list[LeftAl
         return {name: "--links" for name in options.links}, []
     selected: dict[str, str] = {}
     left_alone: list[LeftAlone] = []
-    for name, reason in inertia.links_needing_inertia(model).items():
+    for name, reason in links_needing_inertia(model).items():
         # One reason per link, from the first rule that flags it; I007 runs last, so a link whose
         # reason is I007 has nothing invalid (an invalid one would have been reported first).
         code = reason.split(" ", 1)[0]
@@ -304,3 +305,34 @@ def _clean(values: np.ndarray, relative: float = 0.0, absolute: float = 0.0) -> 
 
 def _tensor_text(values: dict[str, str | None]) -> str:
     return " ".join(f"{k}={values.get(k)}" for k in TENSOR_KEYS)
+
+
+def links_needing_inertia(model: Model) -> dict[str, str]:
+    """``{link name: "CODE name: message"}`` for every link the lint inertia rules (I001-I007) flag.
+
+    The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
+    so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
+    """
+    from ar3cli.lint.context import Context
+    from ar3cli.lint.engine import suppressed_inline
+    from ar3cli.lint.rules.inertia import RULES
+
+    context = Context(model)
+    found: dict[str, str] = {}
+    try:
+        for rule in RULES:
+            for hit in rule.check(context):
+                element = _owning_link(hit.element)
+                if element is None or suppressed_inline(hit.element, rule.code):
+                    continue
+                found.setdefault(element.get("name", ""), f"{rule.code} {rule.name}: {hit.message}")
+    finally:
+        context.close()
+    return {link.name: found[link.name] for link in model.links if link.name in found}
+
+
+def _owning_link(element):
+    """The ``<link>`` element a hit's element belongs to (itself, or an ancestor)."""
+    while element is not None and element.tag != "link":
+        element = element.getparent()
+    return element

@@ -144,7 +144,7 @@ def _read_entries(location: Path) -> dict[str, Any]:
     """The cache file's entries; {} when there is none, or a damaged one (junk, JSON nested
     thousands deep, a pipe in its place: read like a robot file, regular files only)."""
     from ar3cli.errors import UserError
-    from ar3cli.urdf.xmlsource import read_bytes
+    from ar3cli.infra.safe_read import read_bytes
 
     try:
         loaded = json.loads(read_bytes(location))

@@ -16,6 +16,7 @@ import numpy as np
 
 from ar3cli.kinematics import fk as kinematics
 from ar3cli.errors import UserError
+from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import Model
 
 
@@ -73,7 +74,7 @@ def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
     space = sampling.joint_space(body)
     values = sampling.sample_driving(space, count, seed)
     names = list(space.driving_names)
-    all_values = kinematics.driven_values(model, {n: values[:, i] for i, n in enumerate(names)}, count)
+    all_values = driven_values(model, {n: values[:, i] for i, n in enumerate(names)}, count)
     return Samples(seed=seed, names=names, values=values, all_values=all_values)
 
 

@@ -24,6 +24,7 @@ import numpy as np
 
 from ar3cli.errors import UserError
 from ar3cli.physics.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
+from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, ROTATING_JOINT_TYPES, Joint, Model
 
 SUPPORTED_TYPES = (*ACTUATED_JOINT_TYPES, "fixed")
@@ -93,32 +94,6 @@ def joint_motion(joint: Joint, values: np.ndarray) -> np.ndarray:
     if joint.type == "prismatic":
         motion[:, :3, 3] = np.outer(values, unit_axis(joint))
     return motion
-
-
-def driven_values(model: Model, positions: Mapping[str, np.ndarray], count: int) -> dict[str, np.ndarray]:
-    """Every movable joint's value: given ones as they are, mimic joints computed, the rest zero.
-
-    A mimic chain (a mimic of a mimic) is followed; a cycle is a UserError.
-    """
-    values: dict[str, np.ndarray] = {}
-
-    def value_of(joint: Joint, seen: tuple[str, ...] = ()) -> np.ndarray:
-        if joint.name in values:
-            return values[joint.name]
-        if joint.mimic is not None and model.joint(joint.mimic.joint) is not None:
-            if joint.name in seen:
-                raise UserError(f"mimic joints form a cycle: {' -> '.join((*seen, joint.name))}")
-            source = value_of(model.joint(joint.mimic.joint), (*seen, joint.name))  # type: ignore[arg-type]
-            result = joint.mimic.multiplier * source + joint.mimic.offset
-        else:
-            result = np.asarray(positions.get(joint.name, np.zeros(count)), dtype=float)
-        values[joint.name] = result
-        return result
-
-    for joint in model.joints:
-        if joint.type in ACTUATED_JOINT_TYPES:
-            value_of(joint)
-    return values
 
 
 def tree_order(model: Model) -> list[Joint]:

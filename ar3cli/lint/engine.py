@@ -22,6 +22,7 @@ from typing import TYPE_CHECKING, Any
 from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
+from ar3cli.lint.context import Context
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
 
 if TYPE_CHECKING:
@@ -63,38 +64,6 @@ class FileResult:
 
     def to_dict(self) -> dict[str, Any]:
         return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
-
-
-class Context:
-    """What a rule sees: the model, plus lazily built shared helpers (geometry boxes, the PyBullet session)."""
-
-    def __init__(self, model, options: LintOptions) -> None:
-        self.model = model
-        self.options = options
-        self._bounds: dict[str, Any] = {}
-        self._session = None
-
-    def link_bounds(self, link):
-        """Box around the link's collision (else visual) shapes in its frame, or None."""
-        if link.name not in self._bounds:
-            from ar3cli.lint.rules.geometry import link_bounds
-
-            self._bounds[link.name] = link_bounds(link)
-        return self._bounds[link.name]
-
-    @property
-    def session(self):
-        """A PyBullet session for ``--sim`` rules, opened on first use (pybullet is imported only then)."""
-        if self._session is None:
-            from ar3cli.sim.session import Session
-
-            self._session = Session(gravity=-9.81, file_caching=True)
-        return self._session
-
-    def close(self) -> None:
-        if self._session is not None:
-            self._session.close()
-            self._session = None
 
 
 def display_path(path: Path) -> str:
@@ -237,7 +206,7 @@ def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> F
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
     """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
-    context = Context(model, options)
+    context = Context(model)
     locator = Locator(model)
     file_ignores = _file_level_ignores(model.source_bytes)
     findings: list[Finding] = []

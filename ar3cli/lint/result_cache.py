@@ -138,7 +138,7 @@ def _finding(shown: str, rule, severity, message, line, column, hint) -> Finding
 def _read(path: Path) -> bytes | None:
     """The file's bytes as the loader would read them (same size limit), or None."""
     from ar3cli.errors import UserError
-    from ar3cli.urdf.xmlsource import read_bytes
+    from ar3cli.infra.safe_read import read_bytes
 
     try:
         return read_bytes(path)

@@ -4,7 +4,7 @@ A configuration is one value per 1-DOF joint of a loaded :class:`~ar3cli.sim.ses
 :attr:`~ar3cli.sim.session.Body.movable_joints` order (what :meth:`~ar3cli.sim.session.Body.set_positions` and
 ``resetJointStatesMultiDof`` take). Only the *driving* joints are free: a joint with a
 ``<mimic>`` of an existing joint is computed from its source (``multiplier * q + offset``, chains
-followed, by :func:`ar3cli.kinematics.fk.driven_values`), because PyBullet does not couple mimic
+followed, by :func:`ar3cli.urdf.mimic.driven_values`), because PyBullet does not couple mimic
 joints and a configuration with the two fingers of a gripper at unrelated positions is one the
 robot can never reach.
 
@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ar3cli.kinematics import fk as kinematics
+from ar3cli.urdf.mimic import driven_values
 from ar3cli.errors import UserError
 from ar3cli.urdf.model import Model
 
@@ -73,7 +73,7 @@ class JointSpace:
         given = {name: driving_values[:, i] for i, name in enumerate(self.driving_names)}
         if len(self.driving) == len(self.names):
             return driving_values.copy()
-        values = kinematics.driven_values(self.model, given, count)
+        values = driven_values(self.model, given, count)
         columns = [values.get(name, given.get(name, np.zeros(count))) for name in self.names]
         return np.stack(columns, axis=1)
 

@@ -19,6 +19,7 @@ from typing import Any
 from ar3cli.urdf import xacro_expand
 from ar3cli.urdf import xmlsource
 from ar3cli.errors import UserError
+from ar3cli.infra.safe_read import read_bytes
 from ar3cli.urdf.packages import PackageResolver, Resolution
 from ar3cli.urdf.xmlsource import Quirk
 
@@ -265,7 +266,7 @@ def load_model(
 ) -> Model:
     """Read, expand (xacro), parse and index one robot file; bad input raises :class:`UserError`."""
     path = Path(path)
-    source = xmlsource.read_bytes(path)
+    source = read_bytes(path)
     if not source.strip(b"\x00 \t\r\n"):
         raise UserError(f"{path}: file is empty")
     resolver = PackageResolver(path.parent, package_paths)

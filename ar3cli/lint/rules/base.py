@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 from ar3cli.findings import Severity
 
 if TYPE_CHECKING:
-    from ar3cli.lint.engine import Context
+    from ar3cli.lint.context import Context
 
 FAMILIES = {
     "F": "file",

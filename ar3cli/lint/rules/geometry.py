@@ -7,11 +7,7 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
-from ar3cli.physics.tensor_math import rpy_to_matrix
-
-Vector = tuple[float, float, float]
-Box = tuple[Vector, Vector]
-"""An axis-aligned box: (min corner, max corner)."""
+from ar3cli.urdf.bounds import scaled_mesh_bounds
 
 PYBULLET_MESH_FORMATS = (".stl", ".obj", ".dae")
 """What PyBullet's URDF importer loads (anything else: "invalid mesh filename extension")."""
@@ -21,69 +17,6 @@ MIN_PLAUSIBLE_EXTENT = 1e-3
 """A part smaller than a millimetre after scaling was probably scaled twice (or is in km)."""
 FLAT_RATIO = 0.01
 """Meshes whose smallest extent is below this fraction of the largest are planes (ground, walls)."""
-
-
-def shape_bounds(shape) -> Box | None:
-    """Axis-aligned box of one visual/collision shape in its link's frame, or None if unknown.
-
-    The shape's own box (centre ``c``, half-extents ``h``) moved by its origin ``(xyz, R)`` is
-    centred on ``R c + xyz`` with half-extents ``|R| h``: the box around its 8 rotated corners.
-    """
-    geometry = shape.geometry
-    params = geometry.params
-    half: Vector | None = None
-    centre: Vector = (0.0, 0.0, 0.0)
-    if geometry.kind == "box" and params.get("size"):
-        half = tuple(abs(float(v)) / 2 for v in params["size"])  # type: ignore[assignment]
-    elif geometry.kind in ("cylinder", "capsule") and params.get("radius") is not None \
-            and params.get("length") is not None:
-        r, length = abs(params["radius"]), abs(params["length"])
-        half = (r, r, length / 2 + (r if geometry.kind == "capsule" else 0.0))
-    elif geometry.kind == "sphere" and params.get("radius") is not None:
-        half = (abs(params["radius"]),) * 3
-    elif geometry.kind == "mesh":
-        scaled = scaled_mesh_bounds(geometry)
-        if scaled is None:
-            return None
-        low, high = scaled
-        centre = tuple((a + b) / 2 for a, b in zip(low, high))  # type: ignore[assignment]
-        half = tuple((b - a) / 2 for a, b in zip(low, high))  # type: ignore[assignment]
-    if half is None or not all(map(math.isfinite, half)):
-        return None
-    rotation = rpy_to_matrix(shape.origin.rpy)
-    world_centre = [sum(r * c for r, c in zip(row, centre)) + t for row, t in zip(rotation, shape.origin.xyz)]
-    world_half = [sum(abs(r) * h for r, h in zip(row, half)) for row in rotation]
-    return (tuple(c - h for c, h in zip(world_centre, world_half)),  # type: ignore[return-value]
-            tuple(c + h for c, h in zip(world_centre, world_half)))
-
-
-def scaled_mesh_bounds(geometry) -> Box | None:
-    """The mesh's box in the shape frame (file bounds times scale), or None when it cannot be read."""
-    from ar3cli.urdf.meshinfo import mesh_bounds
-
-    resolution = geometry.resolution
-    scale = geometry.params.get("scale")
-    if resolution is None or not resolution.found or scale is None:
-        return None
-    bounds = mesh_bounds(resolution.path)
-    if bounds is None:
-        return None
-    a = [v * s for v, s in zip(bounds[0], scale)]
-    b = [v * s for v, s in zip(bounds[1], scale)]
-    return tuple(map(min, a, b)), tuple(map(max, a, b))  # type: ignore[return-value]
-
-
-def link_bounds(link) -> Box | None:
-    """Box around the link's collision shapes (visual shapes when it has no collision).
-
-    None when no shape has a known box, or when one is placed at a non-finite origin (nan/inf:
-    F007 reports the number; a box built from it would mean nothing).
-    """
-    boxes = [b for b in (shape_bounds(s) for s in (link.collisions or link.visuals)) if b is not None]
-    if not boxes or not all(all(map(math.isfinite, corner)) for box in boxes for corner in box):
-        return None
-    lows, highs = zip(*boxes)
-    return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]
 
 
 def _meshes(ctx):

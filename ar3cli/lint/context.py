@@ -1,0 +1,38 @@
+"""What a lint rule sees: :class:`Context`, the model plus lazily built shared helpers."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ar3cli.urdf.bounds import Box, link_bounds
+from ar3cli.urdf.model import Link, Model
+
+
+class Context:
+    """The model a rule checks, with the link boxes and the PyBullet session built once per file
+    and shared by every rule that asks (pybullet is imported only when a ``--sim`` rule does)."""
+
+    def __init__(self, model: Model) -> None:
+        self.model = model
+        self._bounds: dict[str, Box | None] = {}
+        self._session: Any = None
+
+    def link_bounds(self, link: Link) -> Box | None:
+        """Box around the link's collision (else visual) shapes in its frame, or None."""
+        if link.name not in self._bounds:
+            self._bounds[link.name] = link_bounds(link)
+        return self._bounds[link.name]
+
+    @property
+    def session(self) -> Any:
+        """A PyBullet session (gravity on) for ``--sim`` rules, opened on first use."""
+        if self._session is None:
+            from ar3cli.sim.session import Session
+
+            self._session = Session(gravity=-9.81, file_caching=True)
+        return self._session
+
+    def close(self) -> None:
+        if self._session is not None:
+            self._session.close()
+            self._session = None
