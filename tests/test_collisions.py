@@ -216,6 +216,7 @@ def test_statistics():
     low, high = cm.wilson_interval(5, 10)
     assert (low, high) == pytest.approx((0.2366, 0.7634), abs=1e-4)  # textbook Wilson values
     assert cm.wilson_interval(0, 10)[1] == pytest.approx(0.2775, abs=1e-4)
+    assert cm.wilson_interval(0, 50)[0] == 0.0 and cm.wilson_interval(50, 50)[1] == 1.0  # not 6.9e-18 off
     assert cm.zero_success_upper_bound(10_000) == pytest.approx(2.995e-4, rel=1e-3)  # ~3/N
 
 

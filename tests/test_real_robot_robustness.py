@@ -187,3 +187,26 @@ def test_render_refuses_a_picture_without_the_robot(cli, write_urdf, tmp_path) -
     result = cli("render", str(bare), "-o", str(output))
     assert result.code == 2 and "shows no robot" in result.stderr
     assert not output.exists()
+
+
+def test_a_robot_without_a_name_loads(session, write_urdf) -> None:
+    """pybullet refuses <robot> without a name ("Expected a name for robot"); the copy gets one."""
+    text = (DATA / "in_order.urdf").read_text(encoding="utf-8").replace('<robot name="chain">', "<robot>")
+    body = session.load(load_model(write_urdf(text)))
+    assert len(body.joints) == 5 and body.base_name == "base"
+
+
+def test_render_frames_links_that_have_only_visual_geometry(cli, write_urdf, tmp_path) -> None:
+    """pybullet's getAABB boxes collision shapes only: a visual-only sphere got a 1 mm box and the
+    camera sat inside it (pybullet_data's sphere2red_nocol.urdf rendered blank)."""
+    sphere = write_urdf('<robot name="s"><link name="base"><inertial><mass value="1"/>'
+                        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
+                        '<visual><geometry><sphere radius="0.5"/></geometry></visual></link></robot>')
+    output = tmp_path / "sphere.png"
+    result = cli("render", str(sphere), "-o", str(output), "--width", "64", "--height", "48")
+    assert result.code == 0, result.stderr
+    from PIL import Image
+
+    pixels = Image.open(output).convert("RGB")
+    assert len(pixels.getcolors(maxcolors=100_000)) > 10  # the sphere, shaded, fills the middle
+    assert pixels.getpixel((32, 24)) != pixels.getpixel((0, 0))

@@ -44,7 +44,10 @@ def wilson_interval(successes: int, trials: int, z: float = Z_95) -> tuple[float
     denominator = 1 + z * z / trials
     centre = (phat + z * z / (2 * trials)) / denominator
     half = z * math.sqrt(phat * (1 - phat) / trials + z * z / (4 * trials * trials)) / denominator
-    return max(0.0, centre - half), min(1.0, centre + half)
+    # At 0 (or N) successes the bound is exactly 0 (or 1); computed, it comes out ~1e-17 off.
+    low = 0.0 if successes <= 0 else max(0.0, centre - half)
+    high = 1.0 if successes >= trials else min(1.0, centre + half)
+    return low, high
 
 
 def zero_success_upper_bound(trials: int, confidence: float = 0.95) -> float:

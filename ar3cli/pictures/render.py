@@ -95,9 +95,7 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
         lambda: _draw(model, configuration or {}, width, height, yaw_deg, pitch_deg, show_collision, show_contacts),
         model)
     if picture_is_empty(rgb):
-        raise UserError(f"{model.path}: the picture shows no robot: " + (
-            "no link has <collision> geometry to draw" if show_collision else
-            "no link has <visual> geometry that pybullet draws (try --collision)"))
+        raise UserError(f"{model.path}: the picture shows no robot: {_why_nothing_shows(model, show_collision)}")
     buffer = io.BytesIO()
     Image.fromarray(rgb).save(buffer, format="PNG")
     atomic_write(output, buffer.getvalue())
@@ -126,7 +124,21 @@ def _draw(model: Model, configuration: Mapping[str, float], width: int, height: 
             session.p.changeVisualShape(body.id, body.link_index[link_name], rgbaColor=CONTACT_RGBA,
                                         physicsClientId=session.client)
         report_stage("rendering it")
-        return _snapshot(session, body, width, height, yaw_deg, pitch_deg), values, contacts
+        box = drawn_box(body, show_collision)
+        return _snapshot(session, box, width, height, yaw_deg, pitch_deg), values, contacts
+
+
+def _why_nothing_shows(model: Model, show_collision: bool) -> str:
+    """The likeliest reason pybullet drew nothing, from what the model has to draw."""
+    has_visual = any(link.visuals for link in model.links)
+    has_collision = any(link.collisions for link in model.links)
+    if not has_visual and not has_collision:
+        return "no link has <visual> or <collision> geometry, so there is nothing to draw"
+    if show_collision and not has_collision:
+        return "no link has <collision> geometry (drop --collision to draw the visual geometry)"
+    other = "" if show_collision or not has_collision else "try --collision, or "
+    return (f"pybullet drew none of its geometry (a mesh it cannot read, or a flat shape seen from "
+            f"behind or edge-on); {other}another --yaw/--pitch")
 
 
 def picture_is_empty(rgb) -> bool:
@@ -148,18 +160,48 @@ def configuration_with_mimics(body, configuration: Mapping[str, float]) -> dict[
     return values
 
 
-def _snapshot(session, body, width: int, height: int, yaw_deg: float, pitch_deg: float):
-    """RGB array of the robot, camera aimed at the centre of its bounding box."""
+def drawn_box(body, show_collision: bool):
+    """World (low, high) corners around what the picture shows: each link's drawn shapes (visual,
+    or collision with ``--collision``) boxed in its frame and moved to the link's pose.
+
+    pybullet's ``getAABB`` cannot be used: it boxes the *collision* shapes only, so a link drawn
+    from its visual alone (pybullet_data's sphere2red_nocol) gets a millimetre box and the camera
+    ends up inside the robot. A link whose shapes have no known box (an unreadable mesh) falls back
+    to its ``getAABB``.
+    """
+    import numpy as np
+
+    from ar3cli.urdf.bounds import shape_bounds
+
+    p, client = body.session.p, body.session.client
+    corners = []
+    for name, (position, orientation) in body.link_frames().items():
+        link = body.model.link(name)
+        shapes = () if link is None else (link.collisions if show_collision else link.visuals or link.collisions)
+        boxes = [box for box in map(shape_bounds, shapes) if box is not None]
+        if not boxes and shapes:
+            corners += list(p.getAABB(body.id, body.link_index[name], physicsClientId=client))
+            continue
+        rotation = np.reshape(p.getMatrixFromQuaternion(orientation), (3, 3))
+        for low, high in boxes:
+            local = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
+            corners += list(local @ rotation.T + np.asarray(position))
+    if not corners:  # nothing with a box at all: frame the links' origins
+        corners = [position for position, _ in body.link_frames().values()]
+    points = np.asarray(corners, dtype=float)
+    return points.min(axis=0), points.max(axis=0)
+
+
+def _snapshot(session, box, width: int, height: int, yaw_deg: float, pitch_deg: float):
+    """RGB array of the robot, camera aimed at the centre of ``box`` (world low and high corners)."""
     import numpy as np
 
     p, client = session.p, session.client
-    boxes = [p.getAABB(body.id, index, physicsClientId=client) for index in body.link_index.values()]
-    lows = np.min([box[0] for box in boxes], axis=0)
-    highs = np.max([box[1] for box in boxes], axis=0)
+    lows, highs = box
     target = (lows + highs) / 2.0
     extent = float(np.linalg.norm(highs - lows))
     fov = 45.0
-    distance = max(extent, 0.05) / (2.0 * math.tan(math.radians(fov) / 2.0)) * 0.95
+    distance = max(extent, 0.05) / (2.0 * math.tan(math.radians(fov) / 2.0)) * 1.1  # room for perspective
     view = p.computeViewMatrixFromYawPitchRoll(target.tolist(), distance, yaw_deg, pitch_deg, 0, 2,
                                                physicsClientId=client)
     projection = p.computeProjectionMatrixFOV(fov, width / height, distance / 100.0, distance * 10.0,

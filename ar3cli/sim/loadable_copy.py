@@ -7,6 +7,8 @@ pybullet in three measured ways (``docs/pybullet-facts.md``, sections 7 and 10):
   answer; xacro documents load the same way);
 - very long lines: a valid one-line URDF of ~11,000 characters fails with
   XML_ERROR_PARSING_ATTRIBUTE, so the copy is indented, one element per line;
+- a ``<robot>`` without a name is refused by pybullet ("Expected a name for robot"): the copy
+  gets one;
 - link order: with ``URDF_MAINTAIN_LINK_ORDER`` (which ar3cli passes so that pybullet's link
   indices follow the file), pybullet crashes in C when the root link is not the first ``<link>``
   element (every UR arm of example-robot-data, TIAGo, Talos, PR2, Romeo) and gives NaN frames to a
@@ -27,12 +29,18 @@ from typing import Any
 
 from ar3cli.urdf.model import Model
 
+UNNAMED_ROBOT = "robot"
+"""The name given to a ``<robot>`` without one (UR3 and hector's quadrotor in example-robot-data):
+pybullet refuses to load it, and the name is used for nothing else."""
+
 
 def loadable_document(model: Model) -> bytes:
     """The bytes of the copy pybullet loads: absolute mesh paths, links parent-first, indented."""
     from lxml import etree
 
     root = copy.deepcopy(model.root)
+    if not root.get("name"):
+        root.set("name", UNNAMED_ROBOT)  # pybullet refuses a <robot> without one ("Expected a name for robot")
     _order_links_parent_first(root, ((joint.parent, joint.child) for joint in model.joints))
     etree.indent(root, space=" ")
     for element in root.iter():

@@ -10,10 +10,10 @@ from __future__ import annotations
 
 import contextlib
 import io
-import sys
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.output.report import log
 from ar3cli.urdf.packages import PackageResolver
 
 
@@ -70,8 +70,9 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
         raise UserError(f"{path}: xacro error: {_one_line(exc)}") from None
     finally:
         substitution_args._eval_find = original_find
-    if chatter.getvalue().strip():
-        print(chatter.getvalue().rstrip(), file=sys.stderr)
+    for line in chatter.getvalue().splitlines():
+        if line.strip() and not line.startswith("when processing file:"):
+            log(f"ar3cli: note: {path}: xacro says: {line.strip()}")
     return text.encode("utf-8")
 
 
