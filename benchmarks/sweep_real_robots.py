@@ -1,0 +1,617 @@
+"""Run every ar3cli command on every real robot description and tabulate how each run ended.
+
+Robots come from two public collections:
+
+* example-robot-data (69 URDF + 2 xacro: UR, Panda, Talos, Solo, ANYmal, iCub, PR2, ...), installed
+  once with ``pip install --no-deps --target <cache> example-robot-data`` (~400 MB) into
+  ``~/.cache/ar3cli-sweep/erd`` (``--cache DIR``); an existing install is reused, pip is skipped.
+  Its meshes are ``package://example-robot-data/...``: ar3cli finds that package by itself (the
+  ancestor folder ``share/example-robot-data`` holds its package.xml), so no --package-path is given.
+* pybullet_data, every ``*.urdf`` in it recursively (95 models) except the 1000 procedurally
+  generated ``random_urdfs/`` objects (``--include-random`` adds them).
+
+Each command runs as its own ``ar3cli`` subprocess with ``--format json``, its own empty TMPDIR and
+working folder, a per-run timeout, and never on a writable robot file: the fixers only get --diff,
+render writes its PNG into the run's folder, and the source trees are compared before and after.
+``install-check`` runs once. lint-urdf gets --no-cache --no-config (every file really checked, the
+sweep's working folder's pyproject.toml never applies), and every run gets AR3CLI_CACHE_DIR in the
+sweep's own temporary folder (your ~/.cache/ar3cli is not touched). Every run is classified:
+
+clean           exit 0 or 1, stdout is JSON without NaN/Infinity, and the command-specific checks hold
+user error      exit 2 with a short stderr message and no traceback (expected for bad input)
+crash           killed by a signal (SIGSEGV, SIGABRT, ...)
+internal error  exit 3, a traceback, exit 2 with no or a long message, invalid JSON, NaN/Infinity in
+                JSON, or any other exit code
+silent wrong    looks clean but is not: render wrote a PNG with no robot in it (or none at all),
+                fk-verify's JSON holds NaN or contradicts its exit code, lint's exit code
+                contradicts its findings, a --diff fixer reports a write
+timeout         still running after --timeout seconds (the process group is killed)
+
+Runs that leave anything in their TMPDIR are counted separately ("leftover temp").
+
+Usage (inside the project's venv)::
+
+    python benchmarks/sweep_real_robots.py                       # everything, 2 jobs
+    python benchmarks/sweep_real_robots.py --commands lint-urdf,fix-inertia,fix-continuous
+    python benchmarks/sweep_real_robots.py --source erd --match ur5 --json runs.json
+    python benchmarks/sweep_real_robots.py --help
+
+Commands (``--commands``): lint-urdf, lint-urdf-sim, render, sample-collisions, fk-verify,
+fix-inertia, fix-continuous, install-check.
+
+Time on 2 cores with --jobs 2: the static commands (lint-urdf, fix-inertia, fix-continuous) on the
+166 files take under 3 minutes (ar3cli's mesh cache starts empty in every sweep). The simulating
+ones dominate a full sweep: 1-5 s per run on arms such as the UR5 and Panda (7 commands on one
+arm: 10-20 s of CPU), more on the large humanoids, so estimate 20-40 minutes for everything when
+nothing times out. The first run downloads example-robot-data (~400 MB).
+
+Exit status: 0 when no run failed (crash, internal error, silent wrong, timeout) and no robot
+file changed, 1 otherwise, 2 on a usage error.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import tempfile
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable, Iterable
+from concurrent.futures import Future, ThreadPoolExecutor
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+
+from PIL import Image, ImageChops
+
+DEFAULT_CACHE = Path("~/.cache/ar3cli-sweep/erd").expanduser()
+ERD_SHARE = Path("cmeel.prefix/share/example-robot-data")
+CLASSES = ("clean", "user error", "crash", "internal error", "silent wrong", "timeout")
+FAILURES = ("crash", "internal error", "silent wrong", "timeout")
+MIN_ROBOT_PIXELS = 100
+"""A render with fewer pixels unlike the background than this shows no robot (800x600 = 480000 px)."""
+PIXEL_TOLERANCE = 8
+"""Largest per-channel difference (0-255) at which a pixel still counts as background."""
+SHORT_STDERR_LINES = 3
+"""An exit-2 message longer than this many non-blank lines is not the promised one-line error."""
+
+
+# --------------------------------------------------------------------------------------------
+# Robots
+
+
+@dataclass(frozen=True)
+class Robot:
+    """One robot description file and the collection it belongs to."""
+
+    source: str
+    root: Path
+    path: Path
+
+    @property
+    def rel(self) -> str:
+        return self.path.relative_to(self.root).as_posix()
+
+    @property
+    def label(self) -> str:
+        return f"{self.source}:{self.rel}"
+
+
+def ensure_erd(cache: Path) -> Path:
+    """example-robot-data's robots folder under ``cache``, installed with pip when missing."""
+    robots = cache / ERD_SHARE / "robots"
+    if (cache / ERD_SHARE / "package.xml").is_file() and robots.is_dir():
+        return robots
+    cache.mkdir(parents=True, exist_ok=True)
+    print(f"installing example-robot-data into {cache} (~400 MB)...", file=sys.stderr)
+    pip = [sys.executable, "-m", "pip", "install", "--no-deps", "--target", str(cache), "example-robot-data"]
+    if subprocess.run(pip, stdout=sys.stderr).returncode != 0:
+        raise SystemExit(f"could not install example-robot-data: {' '.join(pip)} failed")
+    if not robots.is_dir():
+        raise SystemExit(f"pip installed example-robot-data but {robots} is missing")
+    return robots
+
+
+def pybullet_data_root() -> Path:
+    import pybullet_data  # imported late: only needed for that source
+
+    return Path(pybullet_data.getDataPath())
+
+
+def find_robots(source: str, root: Path, include_random: bool) -> list[Robot]:
+    """Every .urdf (and .xacro) under ``root``, sorted."""
+    paths = [*root.rglob("*.urdf"), *root.rglob("*.xacro")]
+    if not include_random:
+        paths = [p for p in paths if "random_urdfs" not in p.relative_to(root).parts]
+    return [Robot(source, root, p) for p in sorted(paths)]
+
+
+def select_robots(args: argparse.Namespace) -> list[Robot]:
+    robots: list[Robot] = []
+    if args.source in ("erd", "all"):
+        robots += find_robots("erd", ensure_erd(args.cache), args.include_random)
+    if args.source in ("pybullet_data", "all"):
+        robots += find_robots("pybullet_data", pybullet_data_root(), args.include_random)
+    if args.match:
+        robots = [r for r in robots if args.match.lower() in r.rel.lower()]
+    return robots[:args.limit] if args.limit else robots
+
+
+def snapshot(roots: Iterable[Path]) -> dict[str, tuple[int, int]]:
+    """(size, mtime_ns) of every file under ``roots``: compared after the sweep to prove nothing wrote."""
+    state: dict[str, tuple[int, int]] = {}
+    for root in roots:
+        for path in root.rglob("*"):
+            if path.is_file():
+                info = path.stat()
+                state[str(path)] = (info.st_size, info.st_mtime_ns)
+    return state
+
+
+def snapshot_changes(before: dict[str, tuple[int, int]], after: dict[str, tuple[int, int]]) -> list[str]:
+    changes = [f"added {p}" for p in sorted(after.keys() - before.keys())]
+    changes += [f"removed {p}" for p in sorted(before.keys() - after.keys())]
+    changes += [f"modified {p}" for p in sorted(before.keys() & after.keys()) if before[p] != after[p]]
+    return changes
+
+
+# --------------------------------------------------------------------------------------------
+# Commands
+
+
+@dataclass(frozen=True)
+class Command:
+    """How to run one ar3cli command: ``args(file, run_dir)`` is its argument list (file is "" for install-check)."""
+
+    key: str
+    label: str
+    args: Callable[[str, Path], list[str]]
+    per_file: bool = True
+
+
+COMMANDS: tuple[Command, ...] = (
+    Command("lint-urdf", "lint-urdf",
+            lambda f, d: ["lint-urdf", f, "--no-cache", "--no-config", "--format", "json"]),
+    Command("lint-urdf-sim", "lint-urdf --sim",
+            lambda f, d: ["lint-urdf", "--sim", f, "--no-cache", "--no-config", "--format", "json"]),
+    Command("render", "render",
+            lambda f, d: ["render", f, "-o", str(d / "render.png"), "--format", "json"]),
+    Command("sample-collisions", "sample-collisions",
+            lambda f, d: ["sample-collisions", f, "--samples", "50", "--seed", "1", "--format", "json"]),
+    Command("fk-verify", "fk-verify",
+            lambda f, d: ["fk-verify", f, "--samples", "20", "--seed", "1", "--format", "json"]),
+    Command("fix-inertia", "fix-inertia",
+            lambda f, d: ["fix-inertia", f, "--diff", "--density", "1000", "--format", "json"]),
+    Command("fix-continuous", "fix-continuous",
+            lambda f, d: ["fix-continuous", f, "--diff", "--format", "json"]),
+    Command("install-check", "install-check", lambda f, d: ["install-check", "--format", "json"],
+            per_file=False),
+)
+
+
+def pick_commands(spec: str | None) -> list[Command]:
+    if not spec:
+        return list(COMMANDS)
+    by_key = {c.key: c for c in COMMANDS}
+    wanted = [s.strip() for s in spec.split(",") if s.strip()]
+    unknown = [w for w in wanted if w not in by_key]
+    if unknown:
+        raise ValueError(f"unknown command(s) {', '.join(unknown)}; choose from {', '.join(by_key)}")
+    return [c for c in COMMANDS if c.key in wanted]
+
+
+def find_ar3cli(explicit: str | None) -> str:
+    if explicit:
+        return explicit
+    beside = Path(sys.executable).parent / "ar3cli"
+    found = shutil.which("ar3cli") or (str(beside) if beside.exists() else None)
+    if not found:
+        raise SystemExit("ar3cli not found: activate the project's venv or pass --ar3cli PATH")
+    return found
+
+
+# --------------------------------------------------------------------------------------------
+# Running
+
+
+@dataclass
+class Outcome:
+    """What one subprocess did."""
+
+    returncode: int | None
+    stdout: str
+    stderr: str
+    seconds: float
+    timed_out: bool
+    leftover: list[str]
+
+
+@dataclass
+class RunRecord:
+    """One run, as written by --json."""
+
+    command: str
+    source: str
+    file: str
+    argv: list[str]
+    returncode: int | None
+    seconds: float
+    outcome: str
+    reason: str
+    stderr_first_line: str
+    leftover_temp: list[str] = field(default_factory=list)
+
+
+class Runner:
+    """Runs ar3cli subprocesses, each in its own folder; kills what is still running on interrupt."""
+
+    def __init__(self, ar3cli: str, sweep_dir: Path, timeout: float) -> None:
+        self.ar3cli = ar3cli
+        self.sweep_dir = sweep_dir
+        self.timeout = timeout
+        self.env = {**os.environ, "AR3CLI_CACHE_DIR": str(sweep_dir / "ar3cli-cache")}
+        self.env.pop("AR3CLI_DEBUG", None)  # tracebacks only where ar3cli prints them by itself
+        self._lock = threading.Lock()
+        self._count = 0
+        self._running: set[subprocess.Popen[bytes]] = set()
+        self._stopped = False
+
+    def new_run_dir(self) -> Path:
+        with self._lock:
+            self._count += 1
+            run_dir = self.sweep_dir / f"run{self._count:05d}"
+        (run_dir / "tmp").mkdir(parents=True)
+        return run_dir
+
+    def run(self, argv: list[str], run_dir: Path) -> Outcome:
+        tmp = run_dir / "tmp"
+        env = {**self.env, "TMPDIR": str(tmp), "TMP": str(tmp), "TEMP": str(tmp)}
+        start = time.perf_counter()
+        proc = subprocess.Popen([self.ar3cli, *argv], cwd=run_dir, env=env, stdin=subprocess.DEVNULL,
+                                stdout=subprocess.PIPE, stderr=subprocess.PIPE, start_new_session=True)
+        with self._lock:
+            self._running.add(proc)
+            if self._stopped:  # interrupted while this one was starting
+                kill_group(proc)
+        timed_out = False
+        try:
+            out, err = proc.communicate(timeout=self.timeout)
+        except subprocess.TimeoutExpired:
+            timed_out = True
+            kill_group(proc)
+            out, err = proc.communicate()
+        finally:
+            with self._lock:
+                self._running.discard(proc)
+        seconds = time.perf_counter() - start
+        leftover = sorted(p.name for p in tmp.iterdir())
+        return Outcome(proc.returncode, out.decode("utf-8", "replace"), err.decode("utf-8", "replace"),
+                       seconds, timed_out, leftover)
+
+    def kill_all(self) -> None:
+        with self._lock:
+            self._stopped = True
+            running = list(self._running)
+        for proc in running:
+            kill_group(proc)
+
+
+def kill_group(proc: subprocess.Popen[bytes]) -> None:
+    """SIGKILL the process group ``proc`` leads (ar3cli's worker processes included)."""
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+
+
+# --------------------------------------------------------------------------------------------
+# Classification
+
+
+class NonFinite(ValueError):
+    """JSON held NaN or +-Infinity."""
+
+
+def _reject_constant(token: str) -> float:
+    raise NonFinite(token)
+
+
+def parse_json(text: str) -> tuple[object | None, str]:
+    """The document and '' when ``text`` is strict JSON, else None and what is wrong with it."""
+    try:
+        return json.loads(text, parse_constant=_reject_constant), ""
+    except NonFinite as exc:
+        return None, f"{exc} in JSON"
+    except json.JSONDecodeError as exc:
+        return None, f"invalid JSON on stdout ({exc.msg}, {len(text)} chars)"
+
+
+def first_line(text: str) -> str:
+    return next((line.strip() for line in text.splitlines() if line.strip()), "")
+
+
+def signal_name(returncode: int) -> str:
+    try:
+        return signal.Signals(-returncode).name
+    except ValueError:
+        return f"signal {-returncode}"
+
+
+def classify(command: Command, outcome: Outcome, run_dir: Path) -> tuple[str, str]:
+    """The run's class and a short reason (empty for clean runs)."""
+    rc = outcome.returncode
+    if outcome.timed_out:
+        return "timeout", f"killed after {outcome.seconds:.0f} s"
+    assert rc is not None
+    if rc < 0:
+        return "crash", f"killed by {signal_name(rc)}"
+    if "Traceback" in outcome.stderr:
+        return "internal error", f"exit {rc} with a traceback"
+    if rc == 2:
+        lines = [line for line in outcome.stderr.splitlines() if line.strip()]
+        if not lines:
+            return "internal error", "exit 2 with no message"
+        if len(lines) > SHORT_STDERR_LINES:
+            return "internal error", f"exit 2 with a {len(lines)}-line message"
+        return "user error", ""
+    if rc not in (0, 1):
+        return "internal error", f"exit {rc}"
+    document, problem = parse_json(outcome.stdout)
+    if problem:
+        if command.key == "fk-verify" and problem.endswith("in JSON"):
+            return "silent wrong", problem
+        return "internal error", problem
+    problem = CHECKS.get(command.key, _no_check)(document, rc, run_dir)
+    return ("silent wrong", problem) if problem else ("clean", "")
+
+
+def _no_check(document: object, rc: int, run_dir: Path) -> str:
+    return ""
+
+
+def check_render(document: object, rc: int, run_dir: Path) -> str:
+    """A PNG must exist and show something besides the background."""
+    png = run_dir / "render.png"
+    if not png.is_file():
+        return f"exit {rc} but no PNG written"
+    try:
+        with Image.open(png) as image:
+            rgb = image.convert("RGB")
+    except OSError as exc:
+        return f"unreadable PNG ({exc})"
+    robot = robot_pixels(rgb)
+    if robot < MIN_ROBOT_PIXELS:
+        return f"PNG shows no robot ({robot} of {rgb.width * rgb.height} pixels differ from the background)"
+    return ""
+
+
+def robot_pixels(image: Image.Image) -> int:
+    """Pixels that differ from the background (the most common colour of the image's border)."""
+    width, height = image.size
+    pixels = image.load()
+    border = [pixels[x, y] for x in range(width) for y in (0, height - 1)]
+    border += [pixels[x, y] for y in range(height) for x in (0, width - 1)]
+    background = Counter(border).most_common(1)[0][0]
+    red, green, blue = ImageChops.difference(image, Image.new("RGB", image.size, background)).split()
+    largest = ImageChops.lighter(ImageChops.lighter(red, green), blue)
+    return sum(largest.histogram()[PIXEL_TOLERANCE + 1:])
+
+
+def check_fk(document: object, rc: int, run_dir: Path) -> str:
+    """'passed' must agree with the exit code and with the errors against the tolerances."""
+    if not isinstance(document, dict) or "passed" not in document:
+        return "no 'passed' in the JSON"
+    passed = document["passed"]
+    if passed != (rc == 0):
+        return f"exit {rc} but passed={passed}"
+    worst_m = document.get("max_position_error_m")
+    worst_rad = document.get("max_orientation_error_rad")
+    if passed and isinstance(worst_m, (int, float)) and isinstance(worst_rad, (int, float)):
+        if worst_m > document.get("tolerance_m", 0) or worst_rad > document.get("tolerance_rad", 0):
+            return f"passed with errors {worst_m:.3g} m / {worst_rad:.3g} rad above the tolerances"
+    return ""
+
+
+def check_lint(document: object, rc: int, run_dir: Path) -> str:
+    """Exit 1 exactly when there is an error finding (fail-on error, no config)."""
+    if not isinstance(document, dict) or not isinstance(document.get("findings"), list):
+        return "no 'findings' list in the JSON"
+    errors = sum(1 for f in document["findings"] if isinstance(f, dict) and f.get("severity") == "error")
+    if (errors > 0) != (rc == 1):
+        return f"exit {rc} with {errors} error finding(s)"
+    return ""
+
+
+def check_fix(document: object, rc: int, run_dir: Path) -> str:
+    """With --diff nothing may be written."""
+    if not isinstance(document, dict) or not isinstance(document.get("files"), list):
+        return "no 'files' list in the JSON"
+    written = [f.get("written") for f in document["files"] if isinstance(f, dict) and f.get("written")]
+    return f"--diff run reports a write to {written[0]}" if written else ""
+
+
+CHECKS: dict[str, Callable[[object, int, Path], str]] = {
+    "render": check_render,
+    "fk-verify": check_fk,
+    "lint-urdf": check_lint,
+    "lint-urdf-sim": check_lint,
+    "fix-inertia": check_fix,
+    "fix-continuous": check_fix,
+}
+
+
+def execute(runner: Runner, command: Command, robot: Robot | None) -> RunRecord:
+    """Run ``command`` on ``robot`` (None: a command without a file) and classify it."""
+    run_dir = runner.new_run_dir()
+    try:
+        argv = command.args(str(robot.path) if robot else "", run_dir)
+        outcome = runner.run(argv, run_dir)
+        verdict, reason = classify(command, outcome, run_dir)
+    finally:
+        shutil.rmtree(run_dir, ignore_errors=True)
+    return RunRecord(
+        command=command.label, source=robot.source if robot else "", file=robot.rel if robot else "",
+        argv=["ar3cli", *argv], returncode=outcome.returncode, seconds=round(outcome.seconds, 3),
+        outcome=verdict, reason=reason,
+        stderr_first_line="" if verdict == "clean" else first_line(outcome.stderr),
+        leftover_temp=outcome.leftover)
+
+
+# --------------------------------------------------------------------------------------------
+# Progress and report
+
+
+class Progress:
+    """One stderr line per file once all of its runs have finished."""
+
+    def __init__(self, robots: list[Robot], commands: list[Command]) -> None:
+        self.total = len(robots)
+        self.order = {c.label: i for i, c in enumerate(commands)}
+        self.pending = {r: len(commands) for r in robots}
+        self.records: dict[Robot, list[RunRecord]] = {r: [] for r in robots}
+        self.done = 0
+        self._lock = threading.Lock()
+
+    def finished(self, robot: Robot, record: RunRecord) -> None:
+        with self._lock:
+            self.records[robot].append(record)
+            self.pending[robot] -= 1
+            if self.pending[robot]:
+                return
+            self.done += 1
+            records = sorted(self.records.pop(robot), key=lambda r: self.order.get(r.command, 0))
+        seconds = sum(r.seconds for r in records)
+        bad = [f"{r.command}: {r.outcome}" for r in records if r.outcome != "clean"]
+        status = "; ".join(bad) if bad else "all clean"
+        print(f"[{self.done}/{self.total}] {robot.label} ({seconds:.1f} s): {status}", file=sys.stderr, flush=True)
+
+
+def summary_table(records: list[RunRecord], commands: list[Command]) -> str:
+    header = ["command", "runs", *CLASSES, "leftover temp", "total seconds"]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for command in commands:
+        rows = [r for r in records if r.command == command.label]
+        counts = Counter(r.outcome for r in rows)
+        leftover = sum(1 for r in rows if r.leftover_temp)
+        cells = [f"`{command.label}`", str(len(rows)), *(str(counts[c]) for c in CLASSES),
+                 str(leftover), f"{sum(r.seconds for r in rows):.1f}"]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines)
+
+
+def run_list(records: list[RunRecord], with_reason: bool = True) -> str:
+    lines = []
+    for r in records:
+        where = f" `{r.source}:{r.file}`" if r.file else ""
+        detail = f" ({r.reason})" if with_reason and r.reason else ""
+        stderr = f": {r.stderr_first_line}" if r.stderr_first_line else ""
+        lines.append(f"- `{r.command}`{where} **{r.outcome}**{detail}{stderr}")
+    return "\n".join(lines) or "(none)"
+
+
+def report(records: list[RunRecord], commands: list[Command], changes: list[str], wall: float) -> str:
+    failed = [r for r in records if r.outcome in FAILURES]
+    user = [r for r in records if r.outcome == "user error"]
+    leftover = [r for r in records if r.leftover_temp]
+    parts = [
+        summary_table(records, commands),
+        f"\n### Failed runs ({len(failed)})\n\n{run_list(failed)}",
+        f"\n### User errors ({len(user)}; expected for bad input, worth reading)\n\n{run_list(user, False)}",
+        f"\n### Runs that left files in their TMPDIR ({len(leftover)})\n\n"
+        + ("\n".join(f"- `{r.command}` `{r.source}:{r.file}`: {', '.join(r.leftover_temp)}" for r in leftover)
+           or "(none)"),
+        f"\n### Robot files changed by the sweep ({len(changes)})\n\n"
+        + ("\n".join(f"- {c}" for c in changes) or "(none)"),
+        f"\nTotal wall time: {wall:.1f} s",
+    ]
+    return "\n".join(parts)
+
+
+# --------------------------------------------------------------------------------------------
+# Main
+
+
+def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--source", choices=("erd", "pybullet_data", "all"), default="all",
+                        help="robot collection(s) to sweep (default: all)")
+    parser.add_argument("--cache", type=Path, default=DEFAULT_CACHE,
+                        help=f"where example-robot-data is (or gets) installed (default: {DEFAULT_CACHE})")
+    parser.add_argument("--match", metavar="SUBSTRING",
+                        help="only files whose path (relative to their collection) contains this, any case")
+    parser.add_argument("--limit", type=int, metavar="N", help="only the first N files (after --match)")
+    parser.add_argument("--include-random", action="store_true",
+                        help="also pybullet_data's 1000 generated random_urdfs/ objects")
+    parser.add_argument("--commands", metavar="A,B",
+                        help="comma-separated subset of: " + ", ".join(c.key for c in COMMANDS))
+    parser.add_argument("--jobs", "-j", type=int, default=2, help="subprocesses at once (default: 2)")
+    parser.add_argument("--timeout", type=float, default=300.0, help="seconds per run (default: 300)")
+    parser.add_argument("--json", type=Path, metavar="FILE", help="write every run's record to FILE")
+    parser.add_argument("--ar3cli", metavar="PATH", help="the ar3cli executable (default: from PATH)")
+    args = parser.parse_args(argv)
+    if args.jobs < 1 or (args.limit is not None and args.limit < 1) or args.timeout <= 0:
+        parser.error("--jobs, --limit and --timeout must be positive")
+    try:
+        args.command_list = pick_commands(args.commands)
+    except ValueError as exc:
+        parser.error(str(exc))
+    return args
+
+
+def sweep(runner: Runner, robots: list[Robot], commands: list[Command], jobs: int) -> list[RunRecord]:
+    """Every (file, command) pair plus the file-less commands, ``jobs`` at a time, in submission order."""
+    per_file = [c for c in commands if c.per_file]
+    progress = Progress(robots, per_file)
+    futures: list[Future[RunRecord]] = []
+    with ThreadPoolExecutor(max_workers=jobs) as pool:
+        try:
+            futures += [pool.submit(execute, runner, c, None) for c in commands if not c.per_file]
+            for robot in robots:
+                for command in per_file:
+                    future = pool.submit(execute, runner, command, robot)
+                    future.add_done_callback(
+                        lambda f, robot=robot: f.exception() or progress.finished(robot, f.result()))
+                    futures.append(future)
+            return [f.result() for f in futures]
+        except KeyboardInterrupt:
+            pool.shutdown(wait=False, cancel_futures=True)
+            runner.kill_all()
+            raise
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = parse_args(argv)
+    commands: list[Command] = args.command_list
+    ar3cli = find_ar3cli(args.ar3cli)
+    robots = select_robots(args) if any(c.per_file for c in commands) else []
+    roots = sorted({r.root for r in robots})
+    print(f"{len(robots)} files x {sum(c.per_file for c in commands)} commands, {args.jobs} jobs, "
+          f"ar3cli = {ar3cli}", file=sys.stderr)
+    before = snapshot(roots)
+    sweep_dir = Path(tempfile.mkdtemp(prefix="sweep-real-robots-"))
+    start = time.perf_counter()
+    try:
+        records = sweep(Runner(ar3cli, sweep_dir, args.timeout), robots, commands, args.jobs)
+    finally:
+        shutil.rmtree(sweep_dir, ignore_errors=True)
+    wall = time.perf_counter() - start
+    changes = snapshot_changes(before, snapshot(roots))
+    if args.json:
+        args.json.write_text(json.dumps([asdict(r) for r in records], indent=1) + "\n", encoding="utf-8")
+    print(report(records, commands, changes, wall))
+    failed = any(r.outcome in FAILURES for r in records)
+    return 1 if failed or changes else 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main())
+    except KeyboardInterrupt:
+        print("interrupted: running ar3cli processes killed, temporary folder removed", file=sys.stderr)
+        sys.exit(130)
