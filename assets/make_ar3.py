@@ -38,7 +38,7 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:  # allow `python assets/make_ar3.py` from a plain checkout
     sys.path.insert(0, str(REPO))
 
-from ar3cli.physics import mass_properties as mp  # noqa: E402
+from ar3cli.physics import mass_properties as mp  # noqa: E402 - after the sys.path line that finds ar3cli
 
 PI = math.pi
 

@@ -19,9 +19,9 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ar3cli.collisions.checker import Checker, ModelSource, count_collisions, sample_configurations  # noqa: E402
-from ar3cli.urdf.model import load_model  # noqa: E402
-from ar3cli.sim.session import Session  # noqa: E402
+from ar3cli.collisions.checker import Checker, ModelSource, count_collisions, sample_configurations  # noqa: E402 - after the sys.path line that finds ar3cli
+from ar3cli.sim.session import Session  # noqa: E402 - after the sys.path line that finds ar3cli
+from ar3cli.urdf.model import load_model  # noqa: E402 - after the sys.path line that finds ar3cli
 
 
 def tutorial_loop(model, configs) -> float:

@@ -20,8 +20,8 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from ar3cli.sim.capture import capture_fds
 from ar3cli.grasp.pick_and_lift import TIMESTEP, GraspScene, GraspSettings, run_grasp
+from ar3cli.sim.capture import capture_fds
 
 
 def baseline(seed: int, steps: int) -> float:

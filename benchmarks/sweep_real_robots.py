@@ -52,6 +52,7 @@ file changed, 1 otherwise, 2 on a usage error.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import shutil
@@ -303,10 +304,8 @@ class Runner:
 
 def kill_group(proc: subprocess.Popen[bytes]) -> None:
     """SIGKILL the process group ``proc`` leads (ar3cli's worker processes included)."""
-    try:
+    with contextlib.suppress(ProcessLookupError, PermissionError):
         os.killpg(proc.pid, signal.SIGKILL)
-    except (ProcessLookupError, PermissionError):
-        pass
 
 
 # --------------------------------------------------------------------------------------------
@@ -411,9 +410,9 @@ def check_fk(document: object, rc: int, run_dir: Path) -> str:
         return f"exit {rc} but passed={passed}"
     worst_m = document.get("max_position_error_m")
     worst_rad = document.get("max_orientation_error_rad")
-    if passed and isinstance(worst_m, (int, float)) and isinstance(worst_rad, (int, float)):
-        if worst_m > document.get("tolerance_m", 0) or worst_rad > document.get("tolerance_rad", 0):
-            return f"passed with errors {worst_m:.3g} m / {worst_rad:.3g} rad above the tolerances"
+    numbers = isinstance(worst_m, (int, float)) and isinstance(worst_rad, (int, float))
+    if passed and numbers and (worst_m > document.get("tolerance_m", 0) or worst_rad > document.get("tolerance_rad", 0)):
+        return f"passed with errors {worst_m:.3g} m / {worst_rad:.3g} rad above the tolerances"
     return ""
 
 

@@ -173,7 +173,7 @@ def _yourdfpy(source: Path | io.StringIO):  # noqa: ANN202 - yourdfpy.URDF
     return yourdfpy.URDF.load(source, build_scene_graph=True, load_meshes=False, load_collision_meshes=False)
 
 
-def _link_positions(robot, q: dict[str, float]) -> np.ndarray:  # noqa: ANN001
+def _link_positions(robot, q: dict[str, float]) -> np.ndarray:
     robot.update_cfg(q)
     return np.array([robot.get_transform(f"link_{i}")[:3, 3] for i in range(1, 7)])
 
@@ -331,7 +331,7 @@ def _zero_effort(root: etree._Element) -> etree._Element:
         ("ar3_zero_effort.urdf", _zero_effort),
     ],
 )
-def test_examples_differ_only_where_intended(name: str, mutate) -> None:  # noqa: ANN001
+def test_examples_differ_only_where_intended(name: str, mutate) -> None:
     example = (EXAMPLES / name).read_text()
     assert canonical(parse(EXAMPLES / name)) == canonical(mutate(parse(AR3)))
     assert "<!-- EXAMPLE WITH A DELIBERATE MISTAKE:" in example

@@ -10,11 +10,11 @@ import pytest
 from lxml import etree
 
 from ar3cli.collisions import matrix as cm
-from ar3cli.sim.adjacency import adjacent_pairs
 from ar3cli.collisions.checker import Checker, ModelSource, count_collisions
-from ar3cli.urdf.model import load_model
+from ar3cli.sim.adjacency import adjacent_pairs
 from ar3cli.sim.sampling import limit_configurations, sample_configurations
 from ar3cli.sim.session import PENETRATION_TOLERANCE, Session
+from ar3cli.urdf.model import load_model
 from tests.conftest import ASSETS
 
 ROBOTS = {

@@ -11,11 +11,11 @@ import time
 from pathlib import Path
 
 import pytest
-from tests.conftest import ASSETS, REPO
 
-from ar3cli.infra.atomic import TEMP_MARKER, atomic_write, stale_temps
 from ar3cli.fix.edits import Document
+from ar3cli.infra.atomic import TEMP_MARKER, atomic_write, stale_temps
 from ar3cli.urdf.model import load_model
+from tests.conftest import ASSETS, REPO
 
 NASTY = (
     "\ufeff<?xml version='1.0' encoding='utf-8'?>\r\n"

@@ -7,10 +7,10 @@ import math
 from pathlib import Path
 
 import pytest
-from tests.conftest import ASSETS
-from tests.fixer_helpers import element_lines, lint_findings, only_within, write
 
 from ar3cli.urdf.model import load_model
+from tests.conftest import ASSETS
+from tests.fixer_helpers import element_lines, lint_findings, only_within, write
 
 WHEEL = """<robot name="wheel">
   <link name="base"/>

@@ -8,13 +8,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from tests.conftest import ASSETS
-from tests.fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write
 
-from ar3cli.physics import mass_properties as mp
 from ar3cli.fix.geometry_mass import capsule
 from ar3cli.fix.inertia_plan import links_needing_inertia
+from ar3cli.physics import mass_properties as mp
 from ar3cli.urdf.model import load_model
+from tests.conftest import ASSETS
+from tests.fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write
 
 KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 

@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 import yaml
 
-from ar3cli.kinematics import dh
 from ar3cli.kinematics import compare as fk_compare
+from ar3cli.kinematics import dh
 from ar3cli.kinematics import fk as kinematics
 from ar3cli.urdf.model import load_model
 from tests.conftest import ASSETS

@@ -8,10 +8,10 @@ import math
 import numpy as np
 import pytest
 
-from ar3cli.infra.assets import asset
 from ar3cli.grasp.pick_and_lift import PHASES, GraspSettings, gripper_yaw, run_grasp, sample_cube_pose, strip_wall_clock
-from ar3cli.urdf.model import load_model
+from ar3cli.infra.assets import asset
 from ar3cli.sim.session import Session
+from ar3cli.urdf.model import load_model
 
 
 @pytest.fixture(scope="module")

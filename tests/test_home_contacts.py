@@ -9,8 +9,8 @@ from __future__ import annotations
 import json
 
 from ar3cli.sim.adjacency import adjacent_pairs, nonadjacent_collisions
-from ar3cli.urdf.model import load_model
 from ar3cli.sim.session import Session
+from ar3cli.urdf.model import load_model
 
 PANDA_AT_HOME = {frozenset(("panda_link5", "panda_link7")), frozenset(("panda_link5", "panda_hand")),
                  frozenset(("panda_leftfinger", "panda_rightfinger"))}

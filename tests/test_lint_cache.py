@@ -9,10 +9,10 @@ from pathlib import Path
 import pytest
 
 from ar3cli.infra import file_cache as cache
-from ar3cli.lint import result_cache as lint_cache
-from ar3cli.urdf import model
 from ar3cli.infra.file_cache import FileFacts
+from ar3cli.lint import result_cache as lint_cache
 from ar3cli.lint.engine import LintOptions, _result_cache, lint_paths
+from ar3cli.urdf import model
 
 MESH_ROBOT = """<?xml version="1.0"?>
 <robot name="r">

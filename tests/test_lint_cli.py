@@ -62,7 +62,7 @@ def test_sarif_validates_against_the_schema(cli, write_urdf, tmp_path):
 def test_github_annotations_escape_properties_and_data(cli, write_urdf):
     path = write_urdf(NO_LIMIT, "dir,with:odd/robot.urdf")
     result = cli("lint-urdf", str(path), "--format", "github")
-    line = next(l for l in result.stdout.splitlines() if "title=J001" in l)
+    line = next(text for text in result.stdout.splitlines() if "title=J001" in text)
     assert line.startswith("::error file=") and "dir%2Cwith%3Aodd/robot.urdf" in line
     assert ",line=5,col=3,title=J001::" in line
 

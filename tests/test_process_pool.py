@@ -9,8 +9,8 @@ import signal
 
 import pytest
 
-from ar3cli.infra import process_pool
 from ar3cli.errors import UserError
+from ar3cli.infra import process_pool
 from ar3cli.infra.process_pool import map_in_processes, worker_count
 
 pytestmark = pytest.mark.skipif(not process_pool.can_fork(), reason="forked workers are used on Linux only")

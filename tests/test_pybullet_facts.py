@@ -11,9 +11,9 @@ from pathlib import Path
 import pytest
 
 from ar3cli.infra.isolation import CrashError, run_isolated
-from ar3cli.urdf.model import load_model
 from ar3cli.infra.process_pool import can_fork
 from ar3cli.sim.session import Session
+from ar3cli.urdf.model import load_model
 
 CYLINDER = """<robot name="c"><link name="a"><inertial><mass value="1"/>
 <inertia ixx="0.0158333333333" ixy="0" ixz="0" iyy="0.0158333333333" iyz="0" izz="0.005"/></inertial>

@@ -16,9 +16,9 @@ import pytest
 
 from ar3cli.errors import UserError
 from ar3cli.infra.isolation import CrashError, report_stage, run_isolated
+from ar3cli.infra.process_pool import can_fork
 from ar3cli.sim.loadable_copy import loadable_document, parent_first_order
 from ar3cli.urdf.model import load_model
-from ar3cli.infra.process_pool import can_fork
 
 DATA = Path(__file__).parent / "data" / "link_order"
 REORDERED = ["root_last.urdf", "root_middle.urdf", "child_before_parent.urdf"]

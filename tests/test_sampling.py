@@ -9,8 +9,8 @@ import pytest
 from lxml import etree
 
 from ar3cli.sim import sampling
-from ar3cli.urdf.model import load_model
 from ar3cli.sim.session import Session
+from ar3cli.urdf.model import load_model
 
 BOX = '<inertial><mass value="0.1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="1e-4" iyz="0" izz="1e-4"/></inertial>' \
       '<collision><geometry><box size="{size}"/></geometry></collision>'

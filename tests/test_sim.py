@@ -8,10 +8,10 @@ import textwrap
 
 import pytest
 
-from ar3cli.sim.capture import split_bullet_messages
 from ar3cli.errors import UserError
-from ar3cli.urdf.model import load_model
+from ar3cli.sim.capture import split_bullet_messages
 from ar3cli.sim.session import Session
+from ar3cli.urdf.model import load_model
 
 OFFSET_COM = """<?xml version="1.0"?>
 <robot name="pendulum">

@@ -38,11 +38,11 @@ from pathlib import Path
 
 import numpy as np
 
-from ar3cli.sim.adjacency import collision_links
 from ar3cli.errors import UserError
-from ar3cli.urdf.model import Model, load_model
+from ar3cli.sim.adjacency import collision_links
 from ar3cli.sim.sampling import JointSpace, joint_space
 from ar3cli.sim.session import PENETRATION_TOLERANCE
+from ar3cli.urdf.model import Model, load_model
 
 __all__ = ["Checker", "ModelSource", "count_collisions"]
 

@@ -24,8 +24,8 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
-from ar3cli.sim.adjacency import direct_parent_child
 from ar3cli.findings import Finding, Severity
+from ar3cli.sim.adjacency import direct_parent_child
 from ar3cli.urdf.model import Model
 
 __all__ = ["classify", "findings", "srdf_bytes"]

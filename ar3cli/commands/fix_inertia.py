@@ -41,8 +41,8 @@ def fix_inertia(
     without a valid mass needs --density, --mass or --total-mass: there is no default density.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix.inertia_plan import InertiaOptions, make_fixer, parse_masses
     from ar3cli.fix.driver import run_fixer
+    from ar3cli.fix.inertia_plan import InertiaOptions, make_fixer, parse_masses
 
     if density is not None and not 0 < density < math.inf:
         raise UserError(f"--density {density}: must be a positive number (kg/m^3, e.g. 1200 for PLA)")

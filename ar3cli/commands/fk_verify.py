@@ -5,9 +5,15 @@ from typing import Annotated, Any, Optional
 
 import typer
 
+from ar3cli.commands.options import (
+    FormatOption,
+    PackagePathOption,
+    RobotPathArgument,
+    SeedOption,
+    XacroArgOption,
+    samples_option,
+)
 from ar3cli.errors import UserError
-from ar3cli.commands.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
-                            samples_option)
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 from ar3cli.urdf.loading import load_with_specs
 
@@ -39,8 +45,8 @@ def fk_verify(
     """
     import numpy as np
 
-    from ar3cli.kinematics import dh as dh_module
     from ar3cli.kinematics import compare as fk_compare
+    from ar3cli.kinematics import dh as dh_module
     from ar3cli.sim.session import Session, run_pybullet
 
     if not (tolerance_m > 0 and tolerance_rad > 0):
@@ -86,7 +92,8 @@ def fk_verify(
                                                      "max orientation (rad)", "mean orientation (rad)")))
         dh_lines = [f"DH diagnosis: {d.message}" for d in diagnoses]
         if not dh_ok:
-            dh_lines.append(f"DH worst configuration (sample {worst_index}): {_configuration(drawn.configuration(worst_index))}")
+            worst_values = _configuration(drawn.configuration(worst_index))
+            dh_lines.append(f"DH worst configuration (sample {worst_index}): {worst_values}")
 
     passed = links_ok and dh_ok
     max_position = max((e.max_position for e in comparison.links), default=0.0)

@@ -7,8 +7,8 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from ar3cli.errors import UserError
 from ar3cli.commands.options import FormatOption, SeedOption
+from ar3cli.errors import UserError
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 
 TARGET_RATE = 0.95

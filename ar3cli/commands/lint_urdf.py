@@ -7,8 +7,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.errors import UserError
 from ar3cli.commands.options import PackagePathOption, XacroArgOption
+from ar3cli.errors import UserError
 from ar3cli.output.report import Report, Table, finish
 
 
@@ -29,8 +29,8 @@ class FailOn(str, enum.Enum):
 
 
 def lint_urdf(
-    paths: Annotated[list[Path], typer.Argument(metavar="PATH", help="URDF/xacro files, or folders searched for *.urdf and *.xacro.",
-                                                show_default=False)],
+    paths: Annotated[list[Path], typer.Argument(
+        metavar="PATH", help="URDF/xacro files, or folders searched for *.urdf and *.xacro.", show_default=False)],
     format: Annotated[LintFormat, typer.Option("--format", "-f", help="text (table), json, sarif (SARIF 2.1.0), "
                                                                       "github (workflow annotations) or markdown.")]
     = LintFormat.text,
@@ -67,10 +67,10 @@ def lint_urdf(
     Exit codes: 0 clean, 1 findings at or above --fail-on, 2 usage or I/O error.
     """
     from ar3cli.findings import Severity
-    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
     from ar3cli.lint.config import LintConfig, load_config
-    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
     from ar3cli.lint.rules import validate_patterns
+    from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_expand import parse_xacro_args
 
     config = LintConfig() if no_config else load_config()

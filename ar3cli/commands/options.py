@@ -7,7 +7,6 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.errors import UserError
 from ar3cli.output.report import OutputFormat
 
 FormatOption = Annotated[

@@ -17,8 +17,8 @@ def render_command(
         "--config", metavar="JOINT=VALUE,...",
         help="Joint values in rad (or m); joints not named stay at home (0, or mid-range when 0 is outside "
              "the limits).")] = None,
-    collision: Annotated[bool, typer.Option("--collision", help="Draw the collision geometry (blue) instead of the visual geometry.")]
-    = False,
+    collision: Annotated[bool, typer.Option(
+        "--collision", help="Draw the collision geometry (blue) instead of the visual geometry.")] = False,
     width: Annotated[int, typer.Option(help="Image width in pixels.")] = 800,
     height: Annotated[int, typer.Option(help="Image height in pixels.")] = 600,
     yaw: Annotated[float, typer.Option(help="Camera yaw around the robot, degrees.")] = 45.0,

@@ -6,9 +6,15 @@ from typing import Annotated, Optional
 
 import typer
 
+from ar3cli.commands.options import (
+    FormatOption,
+    PackagePathOption,
+    RobotPathArgument,
+    SeedOption,
+    XacroArgOption,
+    samples_option,
+)
 from ar3cli.errors import UserError
-from ar3cli.commands.options import (FormatOption, PackagePathOption, RobotPathArgument, SeedOption, XacroArgOption,
-                            samples_option)
 from ar3cli.output.report import OutputFormat, Report, Table, console, finish
 
 SamplesOption = Annotated[int, samples_option("Uniform random configurations to check (MoveIt's default: 10000).",
@@ -46,12 +52,12 @@ def sample_collisions(
 
     Pairs are adjacent / default (touching at home) / always / never / sometimes; 'never' comes with
     the 95% upper bound on its collision probability, 'sometimes' with a Wilson 95% interval. The
-    home pose and every driving joint at its limits (mimic joints follow) are checked too. Exit 0 when the matrix was computed.
+    home pose and every driving joint at its limits (mimic joints follow) are checked too. Exit 0 when
+    the matrix was computed.
     """
     from ar3cli.collisions import matrix as cm
-    from ar3cli.sim.adjacency import collision_links
-    from ar3cli.sim.adjacency import adjacent_pairs
     from ar3cli.collisions.checker import Checker
+    from ar3cli.sim.adjacency import adjacent_pairs, collision_links
     from ar3cli.sim.session import run_pybullet
 
     _check_outputs(srdf, pybullet_filter, png)

@@ -7,6 +7,7 @@ detail, and, when not ok, a hint that says exactly what to run. A check that cra
 
 from __future__ import annotations
 
+import functools
 import importlib
 import importlib.metadata
 import os
@@ -146,7 +147,7 @@ def check_import(module: str, distribution: str) -> Callable[[], Check]:
     def run() -> Check:
         try:
             importlib.import_module(module)
-        except Exception as exc:  # broken installs raise more than ImportError
+        except Exception as exc:  # noqa: BLE001 - broken installs raise more than ImportError
             return Check(module, "fail", f"cannot import {module}: {exc}", f"pip install --force-reinstall {distribution}")
         return Check(module, "ok", f"{distribution} {_version(distribution)}")
 
@@ -215,7 +216,7 @@ def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
     for check in checks or CHECKS:
         name = check.__name__.removeprefix("check_")
         try:
-            result = run_isolated(lambda: _run_one(check), f"install-check {name}")
+            result = run_isolated(functools.partial(_run_one, check), f"install-check {name}")
         except CrashError as exc:
             result = Check(name, "fail", f"pybullet crashed ({exc.signal_name}) during this check",
                            "pip install --force-reinstall pybullet  # a broken or incompatible build")
@@ -228,7 +229,7 @@ def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
 def _run_one(check: Callable[[], Check]) -> Check:
     try:
         return check()
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - a check that fails in any way is a "fail" row, never a crash
         name = check.__name__.removeprefix("check_")
         return Check(name, "fail", f"check crashed: {type(exc).__name__}: {exc}",
                      "pip install --force-reinstall ar3cli  # and report this if it persists")
@@ -238,4 +239,4 @@ def import_pybullet_here() -> None:
     """Import pybullet in this process once a child has shown that it imports without crashing, so
     that the next checks' children start with it loaded (the import takes ~0.15 s)."""
     with capture_fds():
-        import pybullet  # noqa: F401
+        import pybullet  # noqa: F401 - imported for its side effect: later children inherit it

@@ -18,9 +18,9 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ar3cli.fix.edits import Document
 from ar3cli.errors import UserError
 from ar3cli.fix.driver import Change, FixPlan, Skipped, number
+from ar3cli.fix.edits import Document
 
 FULL_TURN = 2.0 * math.pi
 FULL_TURN_TOLERANCE = 1e-6

@@ -17,9 +17,9 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ar3cli.infra.atomic import atomic_write, check_writable
-from ar3cli.fix.edits import Document
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
+from ar3cli.fix.edits import Document
+from ar3cli.infra.atomic import atomic_write, check_writable
 from ar3cli.output.report import OutputFormat, Report, Table, render
 
 

@@ -119,7 +119,7 @@ def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float]) -> tuple[
 
     try:
         mesh = trimesh.load(str(path), force="mesh", process=True)
-    except Exception as exc:  # trimesh raises many types for unreadable files
+    except Exception as exc:  # noqa: BLE001 - trimesh raises many types for unreadable files
         raise GeometryError(f"mesh {path.name}: cannot read: {exc}") from None
     if mesh is None or len(getattr(mesh, "faces", ())) == 0:
         raise GeometryError(f"mesh {path.name} has no triangles")

@@ -231,8 +231,8 @@ class GraspScene:
     def __init__(self, seed: int, settings: GraspSettings, gui: bool = False,
                  frame_hook: FrameHook | None = None, realtime: bool = False) -> None:
         from ar3cli.infra.assets import asset
-        from ar3cli.urdf.model import load_model
         from ar3cli.sim.session import Session
+        from ar3cli.urdf.model import load_model
 
         self.settings = settings
         self.frame_hook = frame_hook
@@ -551,9 +551,9 @@ def run_grasp(seed: int = 0, settings: GraspSettings | None = None, gui: bool = 
               frame_hook: FrameHook | None = None) -> GraspResult:
     """One pick-and-lift; never raises for a failed grasp (the result says which phase failed)."""
     settings = settings or GraspSettings()
-    if not 0 < settings.gripper_force:
+    if not settings.gripper_force > 0:
         raise UserError(f"--gripper-force must be positive, got {settings.gripper_force}")
-    import ar3cli.urdf.model  # noqa: F401  (imports are a one-off per process, not the demo's time)
+    import ar3cli.urdf.model  # noqa: F401 - imports are a one-off per process, not the demo's time
     from ar3cli.sim.session import import_pybullet
 
     import_pybullet()

@@ -14,6 +14,7 @@ whatever happened. Where fork is not available (Windows, macOS), the work runs i
 
 from __future__ import annotations
 
+import contextlib
 import os
 import pickle
 import shutil
@@ -121,10 +122,8 @@ def _run_child(work: Callable[[], Result], folder: str, pipe: BinaryIO) -> None:
     except Exception as exc:  # noqa: BLE001 - e.g. a result that cannot be pickled: a bug
         _send(pipe, ("error", f"cannot send the result back: {type(exc).__name__}: {exc}"))
     for stream in (sys.stdout, sys.stderr):
-        try:
+        with contextlib.suppress(Exception):  # a closed stream must not turn into a crash report
             stream.flush()
-        except Exception:  # noqa: BLE001 - a closed stream must not turn into a crash report
-            pass
     pipe.close()
 
 

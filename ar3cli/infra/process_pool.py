@@ -196,10 +196,8 @@ def stop_children(children: list[tuple[int, BinaryIO]], settle: bool) -> None:
         steps = ((None, SETTLE_SECONDS if settle else 0.0), (signal.SIGINT, STOP_SECONDS), (signal.SIGKILL, None))
         for action, seconds in steps:
             for pid in running if action else ():
-                try:
+                with contextlib.suppress(ProcessLookupError):
                     os.kill(pid, action)
-                except ProcessLookupError:
-                    pass
             running = _reap(running, seconds)
             if not running:
                 return

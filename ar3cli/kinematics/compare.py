@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ar3cli.kinematics import fk as kinematics
 from ar3cli.errors import UserError
+from ar3cli.kinematics import fk as kinematics
 from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import Model
 

@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from ar3cli.kinematics import fk as kinematics
 from ar3cli.errors import UserError
+from ar3cli.kinematics import fk as kinematics
 from ar3cli.kinematics.fk import DHRow
 from ar3cli.urdf.model import Joint, Model
 
@@ -261,7 +261,8 @@ def _fmt(values) -> str:
     return " ".join(f"{v:.9g}" for v in values)
 
 
-def constant_offset(evaluation: Evaluation, tolerance_m: float, tolerance_rad: float) -> tuple[np.ndarray | None, np.ndarray | None]:
+def constant_offset(evaluation: Evaluation, tolerance_m: float,
+                    tolerance_rad: float) -> tuple[np.ndarray | None, np.ndarray | None]:
     """(tip-side, base-side) offsets when the DH tip differs from the URDF tip by one constant transform."""
     tip_side = kinematics.invert(evaluation.urdf_tip) @ evaluation.dh_tip  # T_urdf^-1 T_dh
     base_side = evaluation.dh_tip @ kinematics.invert(evaluation.urdf_tip)

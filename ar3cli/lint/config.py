@@ -50,8 +50,8 @@ def find_pyproject(start: Path) -> Path | None:
 
 def load_config(start: Path | None = None) -> LintConfig:
     """Read and validate ``[tool.ar3cli.lint]``; raises UserError (exit 2) on a bad configuration."""
-    from ar3cli.output.report import log
     from ar3cli.lint.rules import REGISTRY, validate_patterns
+    from ar3cli.output.report import log
 
     path = find_pyproject((start or Path.cwd()).resolve())
     if path is None:

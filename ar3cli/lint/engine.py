@@ -19,9 +19,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
+from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
 

@@ -30,8 +30,8 @@ from collections.abc import Mapping
 from pathlib import Path
 
 from ar3cli import __version__
-from ar3cli.infra.file_cache import MISSING, PathState, file_facts, path_state
 from ar3cli.findings import Finding, Severity
+from ar3cli.infra.file_cache import MISSING, PathState, file_facts, path_state
 
 MAX_RESULTS = 2_000
 """Remembered files; beyond this the least recently stored are dropped. Every run reads the whole

@@ -15,8 +15,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from ar3cli.infra.atomic import atomic_write
 from ar3cli.errors import UserError
+from ar3cli.infra.atomic import atomic_write
 
 
 def check_gif_path(path: Path) -> Path:

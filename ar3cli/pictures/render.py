@@ -15,11 +15,11 @@ import io
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any
 from pathlib import Path
+from typing import Any
 
-from ar3cli.infra.atomic import atomic_write
 from ar3cli.errors import UserError
+from ar3cli.infra.atomic import atomic_write
 from ar3cli.urdf.model import Model
 
 CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
@@ -105,8 +105,8 @@ def render(model: Model, output: Path, configuration: Mapping[str, float] | None
 def _draw(model: Model, configuration: Mapping[str, float], width: int, height: int, yaw_deg: float,
           pitch_deg: float, show_collision: bool, show_contacts: bool) -> tuple[Any, dict[str, float], list]:
     """In pybullet: the RGB picture, the joint values drawn, and the links in contact (drawn red)."""
-    from ar3cli.sim.adjacency import nonadjacent_collisions
     from ar3cli.infra.isolation import report_stage
+    from ar3cli.sim.adjacency import nonadjacent_collisions
     from ar3cli.sim.session import SELF_COLLISION_ALL_PAIRS, Session
 
     with Session() as session:

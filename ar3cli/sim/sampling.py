@@ -27,8 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from ar3cli.urdf.mimic import driven_values
 from ar3cli.errors import UserError
+from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import Model
 
 

@@ -29,6 +29,7 @@ Everything here follows measured behaviour (``shared/docs/pybullet-facts.md``), 
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import tempfile
@@ -37,9 +38,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, TypeVar
 
-from ar3cli.sim.capture import capture_fds
 from ar3cli.errors import UserError
 from ar3cli.infra.isolation import report_stage
+from ar3cli.sim.capture import capture_fds
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 Result = TypeVar("Result")
@@ -296,11 +297,8 @@ class Session:
     def close(self) -> None:
         """Disconnect and remove temporary files; safe to call twice."""
         if getattr(self, "client", -1) >= 0:
-            with capture_fds():
-                try:
-                    self.p.disconnect(physicsClientId=self.client)
-                except Exception:  # already gone (e.g. GUI window closed by the user)
-                    pass
+            with capture_fds(), contextlib.suppress(Exception):  # already gone (a GUI window the user closed)
+                self.p.disconnect(physicsClientId=self.client)
             self.client = -1
         if hasattr(self, "_tmp"):
             self._tmp.cleanup()

@@ -100,7 +100,7 @@ def _mesh_bounds(path: Path, _mtime_ns: int, size: int) -> Bounds | None:
             parsed = _obj_columns(path.read_bytes())
         else:
             parsed = _trimesh_columns(path)
-    except Exception:  # a mesh we cannot read is the loader's problem, not a reason to crash the lint
+    except Exception:  # noqa: BLE001 - a mesh we cannot read is the loader's problem, not a reason to crash the lint
         return None
     return _bounds(*parsed) if parsed is not None else None
 

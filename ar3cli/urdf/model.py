@@ -16,10 +16,9 @@ from functools import cached_property, lru_cache
 from pathlib import Path
 from typing import Any
 
-from ar3cli.urdf import xacro_expand
-from ar3cli.urdf import xmlsource
 from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import read_bytes
+from ar3cli.urdf import xacro_expand, xmlsource
 from ar3cli.urdf.packages import PackageResolver, Resolution
 from ar3cli.urdf.xmlsource import Quirk
 

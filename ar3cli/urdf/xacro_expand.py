@@ -62,7 +62,7 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
             text = document.toprettyxml(indent="  ")
     except UserError:
         raise
-    except Exception as exc:  # xacro raises many types: XacroException, NameError, XML errors...
+    except Exception as exc:  # noqa: BLE001 - xacro raises many types: XacroException, NameError, XML errors...
         if not_found:
             raise not_found[-1] from None
         if isinstance(exc, RecursionError):
@@ -92,6 +92,6 @@ def _xacro_location() -> str:
         import xacro
 
         stack = [entry for entry in getattr(xacro, "filestack", None) or [] if entry]
-    except Exception:  # pragma: no cover - defensive: xacro internals differ between versions
+    except Exception:  # noqa: BLE001 - defensive: xacro internals differ between versions
         return ""
     return str(stack[-1]) if stack else ""

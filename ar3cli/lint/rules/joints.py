@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 from collections.abc import Iterator
 
-from ar3cli.urdf.model import ACTUATED_JOINT_TYPES as ACTUATED_TYPES
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.urdf.model import ACTUATED_JOINT_TYPES as ACTUATED_TYPES
 
 LIMITED_TYPES = ("revolute", "prismatic")
 """The types the URDF spec requires a <limit> with lower/upper on."""

@@ -5,8 +5,8 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterator
 
-from ar3cli.urdf.model import URDF_JOINT_TYPES
 from ar3cli.lint.rules.base import Hit, arm, robot, rule
+from ar3cli.urdf.model import URDF_JOINT_TYPES
 
 JOINT_TYPES = URDF_JOINT_TYPES
 PYBULLET_JOINT_TYPES = ("spherical",)
