@@ -51,7 +51,7 @@ def brute_force(model, configs) -> list[dict[frozenset, float]]:
         indices = [-1, *range(p.getNumJoints(body.id, physicsClientId=client))]
         solid = [i for i in indices if p.getCollisionShapeData(body.id, i, physicsClientId=client)]
         names = {index: name for name, index in body.link_index.items()}
-        movable = [joint.index for joint in body.movable_joints]
+        movable = [joint.index for joint in body.actuated_joints]
         for q in configs:
             for index, value in zip(movable, q):
                 p.resetJointState(body.id, index, float(value), physicsClientId=client)

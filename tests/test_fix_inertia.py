@@ -192,7 +192,7 @@ def test_frame_link_gets_a_tiny_inertial_and_leaves_gravity_torques_alone(cli, t
     for variant in (tmp_path / "ar3.urdf", ASSETS / "ar3" / "ar3.urdf"):
         with Session(gravity=-9.81) as session:
             body = session.load(load_model(variant))
-            count = len(body.movable_joints)
+            count = len(body.actuated_joints)
             torques.append(session.p.calculateInverseDynamics(body.id, [0.3] * count, [0.0] * count, [0.0] * count,
                                                               physicsClientId=session.client))
             assert not any("No inertial data" in m for m in session.messages)

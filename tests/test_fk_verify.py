@@ -112,7 +112,7 @@ def test_com_instead_of_link_frame_fails_by_the_com_offset(write_urdf) -> None:
     model = load_model(path)
     with Session() as session:
         body = session.load(model)
-        samples = fk_compare.sample_configurations(model, body, 30, 0)
+        samples = fk_compare.draw_samples(model, body, 30, 0)
         reference = kinematics.urdf_link_frames(model, samples.all_values, samples.count)
         right = fk_compare.compare_links(reference, fk_compare.pybullet_frames(body, samples))
         wrong = fk_compare.compare_links(reference, _com_frames(session, body, samples))

@@ -197,7 +197,7 @@ def test_ik_maxiter_keyword_raises(ik_arm):
 
 def test_ik_null_space_lists_need_one_entry_per_movable_dof(ik_arm):
     session, body = ik_arm
-    movable = body.movable_joints
+    movable = body.actuated_joints
     assert len(movable) == 8
     lower = [joint.lower for joint in movable]
     upper = [joint.upper for joint in movable]

@@ -31,11 +31,11 @@ def test_narrow_terminal_prints_blocks_and_wide_prints_a_table():
 
 
 def test_report_text_payload_goes_to_stdout_and_tables_to_stderr(capsys):
-    from ar3cli.output.report import render
+    from ar3cli.output.report import render_report
 
-    render(Report(data={"a": 1}, tables=[TABLE], lines=["summary"], text="--- a/x\n+++ b/x\n"), "text")
+    render_report(Report(data={"a": 1}, tables=[TABLE], lines=["summary"], text="--- a/x\n+++ b/x\n"), "text")
     captured = capsys.readouterr()
     assert captured.out == "--- a/x\n+++ b/x\n"
     assert "I001" in captured.err and "summary" in captured.err
-    render(Report(data={"a": 1}, tables=[TABLE], text="ignored"), "json")
+    render_report(Report(data={"a": 1}, tables=[TABLE], text="ignored"), "json")
     assert capsys.readouterr().out == '{\n  "a": 1\n}\n'

@@ -70,7 +70,7 @@ def test_without_mimic_the_draw_is_numpys_uniform(pybullet_data_dir):
     with Session() as session:
         body = session.load(model)
         space = sampling.joint_space(body)
-    ranges = np.array([joint.sample_range() for joint in body.movable_joints])
+    ranges = np.array([joint.sample_range() for joint in body.actuated_joints])
     expected = np.random.default_rng(11).uniform(ranges[:, 0], ranges[:, 1], size=(400, 7))
     assert np.array_equal(sampling.sample_configurations(space, 400, 11), expected)
 

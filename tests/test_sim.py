@@ -34,7 +34,7 @@ OFFSET_COM = """<?xml version="1.0"?>
 
 def test_joint_table_knows_continuous_from_urdf(session, write_urdf):
     body = session.load(load_model(write_urdf(OFFSET_COM)))
-    (hinge,) = body.movable_joints
+    (hinge,) = body.actuated_joints
     assert hinge.urdf_type == "continuous" and hinge.continuous
     assert hinge.lower is None and hinge.upper is None  # the fake +-100 is not a limit
     assert hinge.sample_range() == (-math.pi, math.pi)
@@ -61,8 +61,8 @@ def test_floating_base_frame_undoes_inertial_offset(session, write_urdf):
 
 def test_panda_frames_and_self_collision(session, pybullet_data_dir):
     body = session.load(load_model(pybullet_data_dir / "franka_panda" / "panda.urdf"), self_collision="all-pairs")
-    assert len(body.movable_joints) == 9
-    assert body.movable_joints[3].sample_range() == pytest.approx((-3.1416, 0.0))
+    assert len(body.actuated_joints) == 9
+    assert body.actuated_joints[3].sample_range() == pytest.approx((-3.1416, 0.0))
     body.set_positions([0.0, 0.0, 0.0, -1.5, 0.0, 1.5, 0.0, 0.02, 0.02])
     frames = body.link_frames()
     assert set(frames) == set(body.link_names)

@@ -91,7 +91,7 @@ class Checker:
         for pair_id, (i, j) in enumerate(self.pairs):
             a, b = self.body.link_index[self.links[i]] + 1, self.body.link_index[self.links[j]] + 1
             self._lookup[a][b] = self._lookup[b][a] = pair_id
-        self._joint_indices = [joint.index for joint in self.body.movable_joints]
+        self._joint_indices = [joint.index for joint in self.body.actuated_joints]
 
     def __enter__(self) -> Checker:
         return self

@@ -32,12 +32,11 @@ def render_command(
     Links in contact with a link they are not joined to are drawn red: the problem `lint-urdf --sim` reports.
     No display or GPU is needed.
     """
-    from ar3cli.pictures.render import parse_configuration
-    from ar3cli.pictures.render import render as draw
+    from ar3cli.pictures.render import draw_robot, parse_configuration
 
     configuration = parse_configuration(config)
     model = load_with_specs(path, package_path, xacro_arg)
-    result = draw(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
+    result = draw_robot(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
                   show_collision=collision)
     tables = []
     if result.contacts:

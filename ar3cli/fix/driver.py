@@ -20,7 +20,7 @@ from typing import Any
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
 from ar3cli.fix.edits import Document
 from ar3cli.infra.atomic import atomic_write, check_writable
-from ar3cli.output.report import OutputFormat, Report, Table, render
+from ar3cli.output.report import OutputFormat, Report, Table, render_report
 
 
 @dataclass
@@ -61,7 +61,7 @@ Verifier = Callable[[Any, FixPlan], dict[str, Any]]
 
 
 @dataclass
-class FileResult:
+class FixResult:
     path: Path
     plan: FixPlan
     changed: bool
@@ -121,14 +121,14 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     if output is not None and len(paths) != 1:
         raise UserError("-o/--output takes exactly one input file")
     refuse_xacro(paths)
-    planned: list[tuple[FileResult, bytes]] = []
+    planned: list[tuple[FixResult, bytes]] = []
     for path in paths:
         model = load_with_specs(path, package_path, None)
         document = Document(model.source_bytes)
         document.bind(model.root)
         plan = fixer(model, document)
         new = document.apply()
-        result = FileResult(path, plan, changed=new != model.source_bytes)
+        result = FixResult(path, plan, changed=new != model.source_bytes)
         if result.changed:
             _check_parses(path, new)
         if diff and result.changed:
@@ -141,7 +141,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     for result, new in planned:
         target = output or result.path
         if not diff and not check and (result.changed or output is not None):
-            def validate(temp: Path, result: FileResult = result) -> None:
+            def validate(temp: Path, result: FixResult = result) -> None:
                 new_model = load_with_specs(temp, package_path, None)
                 if verifier is not None and result.plan.changes:
                     result.verification = verifier(new_model, result.plan)
@@ -171,7 +171,7 @@ def _diff_name(side: str, path: Path) -> str:
     return str(path) if Path(path).is_absolute() else f"{side}/{path}"
 
 
-def _report(command: str, results: list[FileResult], *, diff: bool, check: bool, fmt: OutputFormat) -> int:
+def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, fmt: OutputFormat) -> int:
     needs_change = any(r.changed for r in results)
     skipped = any(r.plan.skipped for r in results)
     failed_verify = any(r.verification and not r.verification.get("verified", True) for r in results)
@@ -209,5 +209,5 @@ def _report(command: str, results: list[FileResult], *, diff: bool, check: bool,
         else:
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) would change")
     patch = "".join(r.diff for r in results) if diff else ""
-    render(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK, text=patch), fmt)
+    render_report(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK, text=patch), fmt)
     return code

@@ -168,7 +168,7 @@ class IKSolver:
         self.body = session.load(model, fixed_base=True)
         self.p, self.client = session.p, session.client
         self.tcp = self.body.link_index[tcp_link]
-        movable = self.body.movable_joints
+        movable = self.body.actuated_joints
         self.lower = [joint.lower if joint.lower is not None else -math.pi for joint in movable]
         self.upper = [joint.upper if joint.upper is not None else math.pi for joint in movable]
         self.ranges = [hi - lo for lo, hi in zip(self.lower, self.upper)]
@@ -272,7 +272,7 @@ class GraspScene:
         self.arm_velocity = np.array([joint.velocity for joint in self.arm_joints])
         self.tcp = self.arm.link_index[TCP_LINK]
         self.finger_links = [self.arm.link_index[name] for name in FINGER_LINKS]
-        self.movable_names = [joint.name for joint in self.arm.movable_joints]
+        self.movable_names = [joint.name for joint in self.arm.actuated_joints]
         self.steps = 0
         self.wall_start = time.perf_counter()
         self.target_q = np.zeros(len(ARM_JOINTS))

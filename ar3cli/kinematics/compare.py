@@ -64,7 +64,7 @@ class Comparison:
     reference: dict[str, np.ndarray] = field(default_factory=dict)
 
 
-def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
+def draw_samples(model: Model, body, count: int, seed: int) -> Samples:
     """Uniform samples of the driving joints (:mod:`ar3cli.sim.sampling`); mimic joints follow.
 
     Ranges come from :meth:`ar3cli.sim.session.JointRecord.sample_range`, i.e. the URDF's limits.
@@ -79,8 +79,8 @@ def sample_configurations(model: Model, body, count: int, seed: int) -> Samples:
 
 
 def body_configurations(body, samples: Samples) -> np.ndarray:
-    """(N, movable joints) values in :attr:`~ar3cli.sim.session.Body.movable_joints` order, mimic joints included."""
-    names = [joint.name for joint in body.movable_joints]
+    """(N, movable joints) values in :attr:`~ar3cli.sim.session.Body.actuated_joints` order, mimic joints included."""
+    names = [joint.name for joint in body.actuated_joints]
     if not names:
         return np.zeros((samples.count, 0))
     return np.stack([samples.all_values[name] for name in names], axis=1)

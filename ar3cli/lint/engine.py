@@ -53,7 +53,7 @@ class LintOptions:
 
 
 @dataclass
-class FileResult:
+class LintResult:
     """One linted file: its display path, whether it loaded, its findings, and the one-line error
     that cut its check short (pybullet crashed on it under ``--sim``), if any."""
 
@@ -107,8 +107,8 @@ SIM_FILES_PER_WORKER = 2
 
 
 def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = True,
-               jobs: int | None = None) -> list[FileResult]:
-    """Lint every file under ``paths``; one :class:`FileResult` per file, in order.
+               jobs: int | None = None) -> list[LintResult]:
+    """Lint every file under ``paths``; one :class:`LintResult` per file, in order.
 
     With ``use_cache``, unchanged files reuse the findings of an earlier run (:mod:`ar3cli.lint.result_cache`).
     ``jobs`` processes share the files (None: one per CPU for large batches, see
@@ -133,7 +133,7 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
 
 
 def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions,
-                         cache: ResultCache | None) -> tuple[FileResult, dict[str, Any]]:
+                         cache: ResultCache | None) -> tuple[LintResult, dict[str, Any]]:
     """:func:`lint_file`, plus what the on-disk caches learnt meanwhile (a worker never saves them:
     its parent merges and saves)."""
     return lint_file(path, rules, options, cache), take_learned()
@@ -150,7 +150,7 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
                                     xacro_args=options.xacro_args)
 
 
-def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: ResultCache | None = None) -> FileResult:
+def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: ResultCache | None = None) -> LintResult:
     """Load one file and run ``rules`` on it; a load failure is a finding, never an exception.
 
     ``cache`` (a :class:`~ar3cli.lint.result_cache.ResultCache`) answers for unchanged ``.urdf`` files
@@ -163,7 +163,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     if cache is not None and not is_xacro(path):
         remembered = cache.get(path, shown)
         if remembered is not None:
-            return FileResult(shown, True, remembered)
+            return LintResult(shown, True, remembered)
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
@@ -178,11 +178,11 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     # A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
     # always reports syntax errors); only an explicit ignore hides it.
     if matches(finding.rule, options.ignore) or _file_ignored(shown, finding.rule, options):
-        return FileResult(shown, False, [])
-    return FileResult(shown, False, [_override(finding, options)])
+        return LintResult(shown, False, [])
+    return LintResult(shown, False, [_override(finding, options)])
 
 
-def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> FileResult:
+def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
     """Run ``rules`` on a loaded model and apply suppressions and severity overrides.
 
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
@@ -201,7 +201,7 @@ def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> F
         except CrashError as exc:
             error = exc.message
     findings.sort(key=lambda f: (f.line, f.column, f.rule))
-    return FileResult(shown, True, findings, error)
+    return LintResult(shown, True, findings, error)
 
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
@@ -329,7 +329,7 @@ def _override(finding: Finding, options: LintOptions) -> Finding:
     return Finding(finding.rule, severity, finding.message, finding.path, finding.line, finding.column, finding.hint)
 
 
-def summarize(results: list[FileResult], fail_on: Severity) -> dict[str, Any]:
+def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
     """Counts for the summary line and the JSON ``summary`` object."""
     findings = [f for r in results for f in r.findings]
     counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}

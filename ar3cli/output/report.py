@@ -207,7 +207,7 @@ def _json_default(value: Any) -> Any:
     raise TypeError(f"cannot serialise {type(value).__name__}")
 
 
-def render(report: Report, fmt: OutputFormat | str) -> None:
+def render_report(report: Report, fmt: OutputFormat | str) -> None:
     """Render ``report``: the JSON document for ``json``; otherwise the verbatim text (if any) on
     stdout, then all tables, renderables and summary lines (on stderr when there was verbatim text)."""
     if str(getattr(fmt, "value", fmt)) == OutputFormat.json.value:
@@ -238,7 +238,7 @@ def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:
     when ``report.ok``, else 1 (problems found)."""
     import typer
 
-    render(report, fmt)
+    render_report(report, fmt)
     for error in report.errors:
         write(sys.stderr, f"ar3cli: error: {error}\n")
     raise typer.Exit(EXIT_USAGE if report.errors else 0 if report.ok else 1)

@@ -79,7 +79,7 @@ def showing_collision_geometry(model: Model) -> Model:
     return overlay
 
 
-def render(model: Model, output: Path, configuration: Mapping[str, float] | None = None,
+def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | None = None,
            width: int = 800, height: int = 600, yaw_deg: float = 45.0, pitch_deg: float = -20.0,
            show_collision: bool = False, show_contacts: bool = True) -> RenderResult:
     """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``."""
@@ -112,7 +112,7 @@ def _draw(model: Model, configuration: Mapping[str, float], width: int, height: 
     with Session() as session:
         drawn = showing_collision_geometry(model) if show_collision else model
         body = session.load(drawn, self_collision=SELF_COLLISION_ALL_PAIRS)
-        joints = {joint.name: joint for joint in body.movable_joints}
+        joints = {joint.name: joint for joint in body.actuated_joints}
         unknown = sorted(set(configuration) - set(joints))
         if unknown:
             raise UserError(f"--config names unknown joints: {', '.join(unknown)} "

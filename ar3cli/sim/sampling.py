@@ -1,7 +1,7 @@
 """Joint-space sampling shared by sample-collisions and fk-verify.
 
 A configuration is one value per 1-DOF joint of a loaded :class:`~ar3cli.sim.session.Body`, in
-:attr:`~ar3cli.sim.session.Body.movable_joints` order (what :meth:`~ar3cli.sim.session.Body.set_positions` and
+:attr:`~ar3cli.sim.session.Body.actuated_joints` order (what :meth:`~ar3cli.sim.session.Body.set_positions` and
 ``resetJointStatesMultiDof`` take). Only the *driving* joints are free: a joint with a
 ``<mimic>`` of an existing joint is computed from its source (``multiplier * q + offset``, chains
 followed, by :func:`ar3cli.urdf.mimic.driven_values`), because PyBullet does not couple mimic
@@ -89,7 +89,7 @@ def is_mimic(joint: Any, model: Model) -> bool:
 
 def joint_space(body: Any) -> JointSpace:
     """The joint space of a loaded :class:`~ar3cli.sim.session.Body` (its ``model`` gives the mimic couplings)."""
-    joints = body.movable_joints
+    joints = body.actuated_joints
     driving = tuple(i for i, joint in enumerate(joints) if not is_mimic(joint, body.model))
     ranges = np.array([joints[i].sample_range() for i in driving], dtype=float).reshape(-1, 2)
     for i, (lower, upper) in zip(driving, ranges):

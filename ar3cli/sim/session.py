@@ -156,7 +156,8 @@ class Body:
         )
 
     @property
-    def movable_joints(self) -> list[JointRecord]:
+    def actuated_joints(self) -> list[JointRecord]:
+        """The 1-DOF joints (revolute, continuous, prismatic): what a configuration sets, in pybullet order."""
         return [joint for joint in self.joints if joint.movable]
 
     @property
@@ -165,27 +166,27 @@ class Body:
         return [self.base_name, *(joint.link_name for joint in self.joints)]
 
     def set_positions(self, positions: Mapping[str, float] | Sequence[float]) -> None:
-        """Teleport joints (resetJointState); a sequence is in :attr:`movable_joints` order."""
+        """Teleport joints (resetJointState); a sequence is in :attr:`actuated_joints` order."""
         p, client = self.session.p, self.session.client
         if isinstance(positions, Mapping):
             by_name = {joint.name: joint for joint in self.joints}
             for name, value in positions.items():
                 p.resetJointState(self.id, by_name[name].index, float(value), physicsClientId=client)
             return
-        joints = self.movable_joints
+        joints = self.actuated_joints
         if len(positions) != len(joints):
             raise ValueError(f"expected {len(joints)} joint positions, got {len(positions)}")
         for joint, value in zip(joints, positions):
             p.resetJointState(self.id, joint.index, float(value), physicsClientId=client)
 
     def positions(self) -> list[float]:
-        """Current positions of :attr:`movable_joints`."""
+        """Current positions of :attr:`actuated_joints`."""
         return [position for position, _ in self.joint_states()]
 
     def joint_states(self) -> list[tuple[float, float]]:
-        """(position, velocity) of each of :attr:`movable_joints`."""
+        """(position, velocity) of each of :attr:`actuated_joints`."""
         p, client = self.session.p, self.session.client
-        indices = [joint.index for joint in self.movable_joints]
+        indices = [joint.index for joint in self.actuated_joints]
         if not indices:
             return []
         states = p.getJointStates(self.id, indices, physicsClientId=client)
@@ -206,7 +207,7 @@ class Body:
     def release_motors(self) -> None:
         """Turn off the velocity motor pybullet attaches to every joint (target 0, max impulse 1)."""
         p, client = self.session.p, self.session.client
-        indices = [joint.index for joint in self.movable_joints]
+        indices = [joint.index for joint in self.actuated_joints]
         if indices:
             p.setJointMotorControlArray(self.id, indices, p.VELOCITY_CONTROL, forces=[0.0] * len(indices),
                                         physicsClientId=client)
@@ -348,8 +349,8 @@ class Session:
         body = Body(self, body_id, model)
         too_many = (f"{len(body.joints)} joints; pybullet cannot report the states of a body with "
                     f"{MAX_PYBULLET_JOINTS} or more (getJointState fails)" if len(body.joints) >= MAX_PYBULLET_JOINTS
-                    else f"{len(body.movable_joints)} movable joints; pybullet silently ignores resetJointState "
-                         f"beyond {MAX_PYBULLET_DOF}" if len(body.movable_joints) > MAX_PYBULLET_DOF else "")
+                    else f"{len(body.actuated_joints)} movable joints; pybullet silently ignores resetJointState "
+                         f"beyond {MAX_PYBULLET_DOF}" if len(body.actuated_joints) > MAX_PYBULLET_DOF else "")
         if too_many:
             body.remove()
             raise UserError(f"{model.path}: {too_many}, so no simulation of it can be trusted")

@@ -162,12 +162,12 @@ def _differs(used: float, declared: float) -> bool:
       good=arm(), needs_sim=True)
 def sim_unstable(ctx) -> Iterator[Hit]:
     with _loaded(ctx) as body:
-        if body is None or not body.movable_joints:
+        if body is None or not body.actuated_joints:
             return
         body.set_positions(_home(body))
         body.release_motors()
         ctx.session.step(SETTLE_STEPS)  # the lint session has gravity (lint.Context.session)
-        for joint, (position, velocity) in zip(body.movable_joints, body.joint_states()):
+        for joint, (position, velocity) in zip(body.actuated_joints, body.joint_states()):
             if not (math.isfinite(position) and math.isfinite(velocity)):
                 yield Hit(f"joint '{joint.name}' state is NaN/inf after {SETTLE_STEPS} steps under gravity",
                           joint.urdf.element if joint.urdf else None)
