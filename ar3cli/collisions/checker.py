@@ -1,9 +1,14 @@
 """Self-collision sampling: which link pairs touch, in how many joint configurations.
 
 The fast path per configuration is ``resetJointStatesMultiDof`` + ``performCollisionDetection`` +
-one ``getContactPoints(body, body)``, on a body loaded with every pair checked (parent-child
-included). Measured on pybullet_data's panda: ~8,700 configs/s against ~3,400 for the tutorial loop
-(``resetJointState`` per joint + ``stepSimulation``); see ``benchmarks/bench_collisions.py``.
+one ``getContactPoints(body, body)``, on a body loaded with pybullet's own self-collision flag
+(``URDF_USE_SELF_COLLISION``): every pair is checked except a link and its direct parent. Those
+pairs are adjacent by definition (MoveIt disables them a priori), always touch at the joint, and
+checking them was most of the work (their contact points every configuration): they are reported
+as adjacent without being sampled (:attr:`Checker.unsampled`). Pairs that are adjacent only
+across a link without collision geometry (panda_link7 - panda_hand) are still sampled: how often
+they touch is what the ``pybullet-default-self-collision`` warning reports.
+Whole-process timings against the plain script a user would write are in ``benchmarks/``.
 
 Two measured facts shape this module:
 
@@ -18,55 +23,41 @@ Two measured facts shape this module:
   what makes the merged counts identical for any number of jobs.
 - ``getContactPoints`` also reports points at small positive distance (up to ~4 mm on the panda) and
   faces that rest exactly on each other (distance ~1e-17). A pair counts as *colliding* only when it
-  penetrates deeper than :data:`~ar3cli.sim.session.PENETRATION_TOLERANCE` (1 um), the threshold lint-urdf's
-  P002 and render use too.
+  penetrates deeper than :data:`~ar3cli.sim.session.PENETRATION_TOLERANCE` (1 um), the threshold
+  lint-urdf's P002 and render use too.
 
-Configurations are generated up front in the parent by :mod:`ar3cli.sim.sampling` (only the driving
-joints are drawn from ``numpy.random.default_rng(seed)``; ``<mimic>`` joints follow), split
-into chunks, counted by worker processes (one PyBullet client each) and summed: the counts are exact
-and independent of the number of jobs.
+Configurations are generated up front by :mod:`ar3cli.sim.sampling` (only the driving joints are
+drawn from ``numpy.random.default_rng(seed)``; ``<mimic>`` joints follow), split into chunks and
+counted by forked copies of the loaded checker (:mod:`ar3cli.infra.process_pool`, the project's one
+pool): the counts are exact and independent of the number of jobs.
 """
 
 from __future__ import annotations
 
 import gc
 import math
-import multiprocessing
+import os
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-from ar3cli.errors import UserError
-from ar3cli.sim.adjacency import collision_links
+from ar3cli.sim.adjacency import collision_links, direct_parent_child
 from ar3cli.sim.sampling import JointSpace, joint_space
-from ar3cli.sim.session import PENETRATION_TOLERANCE
-from ar3cli.urdf.model import Model, load_model
+from ar3cli.sim.session import PENETRATION_TOLERANCE, SELF_COLLISION_DEFAULT
+from ar3cli.urdf.model import Model
 
-__all__ = ["Checker", "ModelSource", "count_collisions"]
+__all__ = ["Checker", "count_collisions"]
 
 CONTACT_BREAKING_THRESHOLD = 1e-5
 """m: Bullet drops manifold points that drifted more than this; small, so teleports leave no stale points."""
 
 
-@dataclass(frozen=True)
-class ModelSource:
-    """How to load the model again in a worker process (a Model holds lxml trees: not picklable)."""
-
-    path: Path
-    package_paths: dict[str, Path] = field(default_factory=dict)
-    xacro_args: dict[str, str] = field(default_factory=dict)
-
-    def load(self) -> Model:
-        return load_model(self.path, self.package_paths or None, self.xacro_args or None)
-
-
 class Checker:
-    """One PyBullet client with the model loaded for all-pairs self-collision; counts colliding pairs.
+    """One PyBullet client with the model loaded for self-collision; counts colliding pairs.
 
     ``pairs`` are the unordered pairs of :attr:`links` (links with collision geometry, in pybullet
-    order, base first), as (i, j) with i < j; counts are indexed like ``pairs``.
+    order, base first), as (i, j) with i < j; counts are indexed like ``pairs``. The pairs in
+    :attr:`unsampled` (a link and its direct parent) are never checked: their count stays 0.
     """
 
     def __init__(self, model: Model) -> None:
@@ -77,7 +68,7 @@ class Checker:
             p, client = self.session.p, self.session.client
             p.setPhysicsEngineParameter(contactBreakingThreshold=CONTACT_BREAKING_THRESHOLD,
                                         physicsClientId=client)
-            self.body = self.session.load(model, self_collision="all-pairs")
+            self.body = self.session.load(model, self_collision=SELF_COLLISION_DEFAULT, visuals=False)
         except BaseException:
             self.session.close()
             raise
@@ -92,6 +83,9 @@ class Checker:
             a, b = self.body.link_index[self.links[i]] + 1, self.body.link_index[self.links[j]] + 1
             self._lookup[a][b] = self._lookup[b][a] = pair_id
         self._joint_indices = [joint.index for joint in self.body.actuated_joints]
+        direct = direct_parent_child(model)
+        self.unsampled: set[int] = {pair_id for pair_id, (i, j) in enumerate(self.pairs)
+                                    if frozenset((self.links[i], self.links[j])) in direct}
 
     def __enter__(self) -> Checker:
         return self
@@ -137,13 +131,6 @@ class Checker:
 
 
 # ---- parallel counting ----------------------------------------------------------------------------
-# The parent and J-1 child processes pull chunks from a shared counter until none is left, so a
-# process that starts late or runs slowly simply takes fewer chunks; every chunk's counts depend
-# only on its configurations, so the sums are exact and identical for any J.
-_inherited_checker: Checker | None = None
-_DONE = "done"
-
-
 def chunk_bounds(total: int, jobs: int, per_job: int = 8, minimum: int = 100) -> list[tuple[int, int]]:
     """Contiguous [start, stop) chunks: about ``per_job`` per job (balance, progress), none tiny."""
     if total <= 0:
@@ -153,93 +140,40 @@ def chunk_bounds(total: int, jobs: int, per_job: int = 8, minimum: int = 100) ->
     return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if b > a]
 
 
-def start_method() -> str:
-    """``fork`` where the platform has it: the child inherits the parent's loaded client (a private
-    copy-on-write copy of an in-process DIRECT world), so a worker starts in milliseconds instead of
-    ~0.7 s (Python start + pybullet import + loading and hulling the meshes again). Elsewhere ``spawn``,
-    and each worker loads the model itself."""
-    return "fork" if "fork" in multiprocessing.get_all_start_methods() else "spawn"
+SAMPLES_PER_WORKER = 2_000
+"""Automatic --jobs adds a process per this many samples: a forked copy of the loaded checker starts
+in about a millisecond, but below a couple of thousand configurations (~0.2 s) it does not pay."""
 
 
-def _claim(next_chunk, chunks) -> tuple[int, int] | None:
-    with next_chunk.get_lock():
-        index = next_chunk.value
-        next_chunk.value += 1
-    return chunks[index] if index < len(chunks) else None
+def count_collisions(checker: Checker, configs: np.ndarray, jobs: int | None = None,
+                     progress: Callable[[int], None] | None = None) -> np.ndarray:
+    """Per-pair collision counts over ``configs`` (rows): exact and independent of ``jobs``.
 
-
-def _child(source: ModelSource | None, configs: np.ndarray, chunks, next_chunk, results) -> None:
-    """A worker process: count chunks until none is left, then say so (errors travel as messages)."""
-    try:
-        checker = _inherited_checker if source is None else Checker(source.load())
-        assert checker is not None
-        while (chunk := _claim(next_chunk, chunks)) is not None:
-            results.put((chunk[1] - chunk[0], checker.count(configs[chunk[0]:chunk[1]])))
-    except BaseException as exc:  # noqa: BLE001 - reported by the parent as a one-line error
-        results.put(("error", str(exc)))
-    finally:
-        results.put(_DONE)
-
-
-def count_collisions(
-    checker: Checker,
-    source: ModelSource,
-    configs: np.ndarray,
-    jobs: int = 1,
-    progress: Callable[[int], None] | None = None,
-    method: str | None = None,
-) -> np.ndarray:
-    """Per-pair collision counts over ``configs`` (rows), in ``checker`` plus ``jobs - 1`` worker
-    processes (one PyBullet client each); exact and independent of ``jobs``.
-
-    ``progress(n)`` is called with the number of configurations finished, chunk by chunk.
+    ``jobs`` processes share the chunks, this one included (None: one per CPU, one per
+    :data:`SAMPLES_PER_WORKER` samples); each child is a fork of this process with the model
+    already loaded (a private copy-on-write copy of the in-process DIRECT world), so it starts in
+    milliseconds. ``progress(n)`` is called as chunks finish (this process's own chunks, scaled
+    by the number of processes: the others advance at the same pace).
     """
-    global _inherited_checker
-    chunks = chunk_bounds(len(configs), jobs)
-    counts = np.zeros(len(checker.pairs), dtype=np.int64)
+    from ar3cli.infra.process_pool import map_in_processes, worker_count
+
+    chunks = chunk_bounds(len(configs), jobs or 1)
+    workers = worker_count(jobs, len(configs), SAMPLES_PER_WORKER)
+    if workers > 1:
+        chunks = chunk_bounds(len(configs), workers)
+    parent = os.getpid()
     tick = progress or (lambda done: None)
-    if jobs <= 1 or len(chunks) <= 1:
-        for start, stop in chunks:
-            counts += checker.count(configs[start:stop])
-            tick(stop - start)
+
+    def count(bounds: tuple[int, int]) -> np.ndarray:
+        start, stop = bounds
+        counts = checker.count(configs[start:stop])
+        if os.getpid() == parent:
+            tick((stop - start) * workers)
         return counts
-    method = method or start_method()
-    context = multiprocessing.get_context(method)
-    next_chunk, results = context.Value("i", 0), context.SimpleQueue()
-    _inherited_checker = checker if method == "fork" else None
-    children = [context.Process(target=_child, daemon=True,
-                                args=(None if method == "fork" else source, configs, chunks, next_chunk, results))
-                for _ in range(min(jobs, len(chunks)) - 1)]
+
     gc.freeze()  # forked children then leave the parent's objects alone: fewer copy-on-write page faults
     try:
-        for child in children:
-            child.start()
-        running = len(children)
-
-        def take(message) -> None:
-            nonlocal counts, running
-            if message == _DONE:
-                running -= 1
-            elif message[0] == "error":
-                raise UserError(f"{source.path}: a collision worker failed: {message[1]}")
-            else:
-                counts += message[1]
-                tick(message[0])
-
-        while (chunk := _claim(next_chunk, chunks)) is not None:
-            counts += checker.count(configs[chunk[0]:chunk[1]])
-            tick(chunk[1] - chunk[0])
-            while not results.empty():
-                take(results.get())
-        while running:
-            if results.empty() and not any(child.is_alive() for child in children):
-                raise UserError(f"{source.path}: a collision worker process died; rerun with --jobs 1")
-            take(results.get())
+        parts = map_in_processes(count, chunks, workers, what="a collision worker")
     finally:
         gc.unfreeze()
-        _inherited_checker = None
-        for child in children:
-            child.join(timeout=5)
-            if child.is_alive():
-                child.terminate()
-    return counts
+    return np.sum(parts, axis=0, dtype=np.int64) if parts else np.zeros(len(checker.pairs), dtype=np.int64)

@@ -70,6 +70,11 @@ class PairResult:
     limit_hits: list[str] = field(default_factory=list)
 
     @property
+    def sampled(self) -> bool:
+        """False for a link and its direct parent: adjacent, never checked (``samples`` is 0)."""
+        return self.samples > 0
+
+    @property
     def fraction(self) -> float:
         return self.collisions / self.samples if self.samples else 0.0
 
@@ -88,7 +93,8 @@ class PairResult:
         low, high = self.interval
         return {"link_a": self.link_a, "link_b": self.link_b, "category": self.category,
                 "collisions": self.collisions, "fraction": self.fraction, "upper_bound": self.upper_bound,
-                "interval_95": [low, high], "at_home": self.at_home, "limit_hits": self.limit_hits}
+                "interval_95": [low, high], "at_home": self.at_home, "limit_hits": self.limit_hits,
+                "sampled": self.sampled}
 
 
 def classify(
@@ -100,8 +106,10 @@ def classify(
     home_hits: set[int],
     limit_hits: dict[int, list[str]],
     always_threshold: float = 0.95,
+    unsampled: set[int] | frozenset[int] = frozenset(),
 ) -> list[PairResult]:
-    """One :class:`PairResult` per pair, categorised adjacent > default > always > never > sometimes."""
+    """One :class:`PairResult` per pair, categorised adjacent > default > always > never > sometimes.
+    Pairs in ``unsampled`` (a link and its direct parent: adjacent) get ``samples`` 0."""
     results = []
     for pair_id, (i, j) in enumerate(pairs):
         a, b = links[i], links[j]
@@ -117,7 +125,8 @@ def classify(
             category = "never"
         else:
             category = "sometimes"
-        results.append(PairResult(a, b, category, collisions, samples, pair_id in home_hits, hits))
+        results.append(PairResult(a, b, category, collisions, 0 if pair_id in unsampled else samples,
+                                  pair_id in home_hits, hits))
     return results
 
 

@@ -56,7 +56,7 @@ def fk_verify(
 
     def measure() -> tuple[fk_compare.Samples, fk_compare.Comparison]:
         with Session() as session:
-            body = session.load(model, fixed_base=True)
+            body = session.load(model, fixed_base=True, visuals=False)
             drawn = fk_compare.draw_samples(model, body, samples, seed)
             if format is OutputFormat.text:
                 log(f"fk-verify: {samples} samples, seed {seed}")

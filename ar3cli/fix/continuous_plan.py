@@ -258,7 +258,7 @@ def _checks_in_pybullet(model, joints: dict) -> list[dict]:
 
     checks: list[dict] = []
     with Session() as session:
-        body = session.load(model)
+        body = session.load(model, visuals=False)
         p = session.p
         records = {record.name: record for record in body.joints}
         for name, expected in joints.items():

@@ -1,7 +1,7 @@
 """The PyBullet session: connecting, capturing pybullet's C output, loading, link frames, contacts.
 
 :class:`Session` and :class:`Body` own what every command needs the same way: the connection
-(DIRECT, file caching off, output captured), loading a Model, the joint table, setting and
+(DIRECT, output captured), loading a Model, the joint table, setting and
 reading joint positions, link frames, masses and inertias as PyBullet uses them, self-contacts,
 removing a body. Commands make their domain-specific calls (camera images, motors, IK, friction,
 collision filters, ...) through ``session.p``, always with ``physicsClientId=session.client``.
@@ -10,11 +10,12 @@ Everything here follows measured behaviour (``shared/docs/pybullet-facts.md``), 
 
 - pybullet is imported and used inside :func:`~ar3cli.sim.capture.capture_fds`, so nothing it prints
   from C reaches stdout; what it says is kept in :attr:`Session.messages`.
-- File caching is off by default (pybullet caches files by name for the whole session, so a URDF
-  rewritten by a fixer would otherwise load with its OLD content), and every load gets a fresh file
-  name besides. Caching off costs time when many models share meshes (measured: the 95 models of
-  pybullet_data load in 12.1 s uncached, 2.7 s cached), so bulk loaders may pass
-  ``file_caching=True``: the fresh names still guarantee the URDF itself is never stale.
+- pybullet caches files by name for the whole session, so a URDF rewritten by a fixer would load
+  with its OLD content under the same name: every load gets a fresh file name, so the URDF itself is
+  never stale. Meshes (which no command rewrites) are read once: caching is on by default, because
+  off it reads every mesh each time it is named (measured: the panda loads in 0.20 s cached, 0.42 s
+  uncached, as the visual and collision shapes name the same files; the 95 models of pybullet_data
+  in 2.7 s against 12.1 s). ``file_caching=False`` is there for a caller that rewrites meshes.
 - Meshes are resolved by ar3cli (``package://`` included) and handed to pybullet as absolute
   paths, in a temporary copy of the document: xacro files load the same way.
 - Joint types come from the URDF: pybullet reports continuous joints as revolute with the
@@ -48,6 +49,10 @@ Pose = tuple[tuple[float, float, float], tuple[float, float, float, float]]
 """(position xyz, quaternion xyzw) in the world frame."""
 
 SELF_COLLISION_ALL_PAIRS = "all-pairs"
+"""``Session.load(self_collision=...)``: every pair of links, a link and its parent included."""
+SELF_COLLISION_DEFAULT = "default"
+"""``Session.load(self_collision=...)``: pybullet's own ``URDF_USE_SELF_COLLISION``, every pair but a
+link and its direct parent."""
 PENETRATION_TOLERANCE = 1e-6
 """m: two links *collide* when their deepest contact point penetrates more than this.
 
@@ -275,7 +280,7 @@ class Session:
     """
 
     def __init__(self, gui: bool = False, gravity: float = 0.0, timestep: float = 1.0 / 240.0,
-                 file_caching: bool = False) -> None:
+                 file_caching: bool = True) -> None:
         self.p = import_pybullet()
         self.messages: list[str] = []
         mode = self.p.GUI if gui else self.p.DIRECT
@@ -314,17 +319,21 @@ class Session:
         self_collision: str | None = None,
         maximal_coordinates: bool = False,
         allow_nan_frames: bool = False,
+        visuals: bool = True,
     ) -> Body:
         """Load ``model`` with explicit flags; raises UserError quoting pybullet's reason on failure.
 
         Default flags: ``URDF_USE_INERTIA_FROM_FILE`` (pybullet's default recomputes every tensor
         from the collision AABB) and ``URDF_MAINTAIN_LINK_ORDER``. ``self_collision="all-pairs"``
-        adds ``URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_INCLUDE_PARENT``.
+        adds ``URDF_USE_SELF_COLLISION | URDF_USE_SELF_COLLISION_INCLUDE_PARENT``, ``"default"``
+        adds ``URDF_USE_SELF_COLLISION`` alone (no pair of a link and its direct parent).
         ``maximal_coordinates=True`` loads a free object as a plain rigid body instead of a
         multibody (``useMaximalCoordinates``): its contacts are cheaper to solve.
         A body whose link frames are NaN at the zero configuration (a zero joint axis, say) is
         refused with a UserError, so that no command computes with NaN; ``allow_nan_frames=True``
-        is for the lint rules that report exactly that.
+        is for the lint rules that report exactly that. ``visuals=False`` loads without the
+        ``<visual>`` elements, several times faster, for work that never draws (frames, contacts,
+        dynamics).
         """
         p = self.p
         refuse_what_crashes_pybullet(model)
@@ -332,7 +341,9 @@ class Session:
             flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_MAINTAIN_LINK_ORDER
         if self_collision == SELF_COLLISION_ALL_PAIRS:
             flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_INCLUDE_PARENT
-        urdf_path = self._write_loadable_copy(model)
+        elif self_collision == SELF_COLLISION_DEFAULT:
+            flags |= p.URDF_USE_SELF_COLLISION
+        urdf_path = self._write_loadable_copy(model, visuals)
         report_stage("loading it")
         with capture_fds() as captured:
             try:
@@ -362,12 +373,12 @@ class Session:
                             "simulation of it can be trusted; see ar3cli lint-urdf")
         return body
 
-    def _write_loadable_copy(self, model: Model) -> Path:
+    def _write_loadable_copy(self, model: Model, visuals: bool = True) -> Path:
         """Write the copy pybullet loads (:mod:`ar3cli.sim.loadable_copy`) under a fresh name."""
         from ar3cli.sim.loadable_copy import write_loadable_copy
 
         name = f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
-        return write_loadable_copy(model, Path(self._tmp.name) / name)
+        return write_loadable_copy(model, Path(self._tmp.name) / name, visuals)
 
     def step(self, count: int = 1) -> None:
         for _ in range(count):

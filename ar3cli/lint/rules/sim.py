@@ -26,7 +26,7 @@ def _loaded(ctx, **load_options):
     """Load the model into the file's session and remove it afterwards; yields None when it fails."""
     session = ctx.session
     try:
-        body = session.load(ctx.model, allow_nan_frames=True, **load_options)
+        body = session.load(ctx.model, allow_nan_frames=True, visuals=False, **load_options)
     except UserError:
         yield None
         return

@@ -1,0 +1,66 @@
+"""The self-collision matrix as a :class:`~ar3cli.output.report.Report`: JSON document, table, heat
+map and summary lines."""
+
+from __future__ import annotations
+
+from ar3cli.collisions import matrix as cm
+from ar3cli.collisions.run import MatrixRun
+from ar3cli.output.report import OutputFormat, Report, Table
+from ar3cli.urdf.model import Model
+
+
+def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str) -> Report:
+    """Always ok: the warnings describe the robot, they do not fail the run."""
+    from ar3cli.sim.session import PENETRATION_TOLERANCE
+
+    counts = cm.category_counts(run.results)
+    never_bound = cm.zero_success_upper_bound(run.samples)
+    data = {
+        "path": str(model.path), "robot": model.name, "samples": run.samples, "seed": run.seed, "jobs": run.jobs,
+        "always_threshold": run.always_threshold, "contact_tolerance_m": PENETRATION_TOLERANCE,
+        "links": list(run.links), "limit_configurations": run.limit_configurations,
+        "pairs": [result.to_dict() for result in run.results],
+        "categories": counts, "never_upper_bound": never_bound,
+        "warnings": [finding.to_dict() for finding in run.warnings],
+        "configs_per_second": run.configs_per_second, "elapsed_s": run.elapsed_s,
+    }
+    if OutputFormat(fmt) is OutputFormat.json:
+        return Report(data=data)
+    title = f"self-collision pairs of {model.path.name} ({run.samples} samples, seed {run.seed})"
+    table = Table(title=title, columns=["link a", "link b", "category", "collisions", "fraction", "95% interval",
+                                        "at home", "limit hits"],
+                  rows=[_row(result) for result in _ordered(run.results)],
+                  caption="a link and its direct parent are adjacent and not sampled (-)",
+                  numeric_columns=("collisions", "fraction", "limit hits"))
+    summary = ", ".join(f"{counts[c]} {c}" for c in cm.CATEGORIES)
+    rate = run.configs_per_second
+    lines = [
+        f"seed {run.seed}: {run.samples} uniform samples + {run.limit_configurations} home/limit configurations, "
+        f"{len(run.pairs)} pairs of {len(run.links)} links with collision geometry, {run.dof} joints",
+        f"{summary}; {_count(sum(counts[c] for c in cm.DISABLED), 'pair')} to disable",
+        f"'never' means: collision probability below {never_bound:.2g} with 95% confidence (exact bound, "
+        f"~3/N); more samples tighten it",
+        f"{rate:,.0f} configurations/s with {_count(run.jobs, 'job')}" if rate else "",
+    ]
+    lines += [f"{w.severity.value}: {w.message}" + (f" ({w.hint})" if w.hint else "") for w in run.warnings]
+    return Report(data=data, tables=[table], renderables=[cm.heat_map(run.links, run.pairs, run.results)],
+                  lines=[line for line in lines if line])
+
+
+def _ordered(results: list[cm.PairResult]) -> list[cm.PairResult]:
+    return sorted(results, key=lambda r: (not r.sampled, -r.fraction, cm.CATEGORIES.index(r.category),
+                                          r.link_a, r.link_b))
+
+
+def _row(result: cm.PairResult) -> list:
+    if not result.sampled:
+        return [result.link_a, result.link_b, result.category, "-", "-", "-", "yes" if result.at_home else "", ""]
+    low, high = result.interval
+    return [result.link_a, result.link_b, result.category, result.collisions, f"{result.fraction:.4f}",
+            f"{low:.4f}-{high:.4f}" if result.collisions else f"<= {result.upper_bound:.2g}",
+            "yes" if result.at_home else "", len(result.limit_hits) or ""]
+
+
+def _count(number: int, noun: str) -> str:
+    """``1 pair``, ``3 pairs``."""
+    return f"{number} {noun}{'' if number == 1 else 's'}"

@@ -1,0 +1,115 @@
+"""One sample-collisions run: load the model in pybullet (in a forked child), check the home and
+limit configurations, count the uniform samples, classify every pair like MoveIt."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ar3cli.collisions import matrix as cm
+from ar3cli.errors import UserError
+from ar3cli.findings import Finding
+from ar3cli.urdf.model import Model
+
+
+@dataclass
+class MatrixRun:
+    """What a run found: the links and pairs, each pair's result, and how the sampling went."""
+
+    links: list[str]
+    pairs: list[tuple[int, int]]
+    results: list[cm.PairResult]
+    warnings: list[Finding]
+    samples: int
+    seed: int
+    jobs: int
+    limit_configurations: int
+    dof: int
+    elapsed_s: float
+    always_threshold: float
+    unsampled: set[int] = field(default_factory=set)
+
+    @property
+    def configs_per_second(self) -> float | None:
+        return self.samples / self.elapsed_s if self.elapsed_s > 0 else None
+
+
+@dataclass
+class _Counted:
+    """What the pybullet child sends back (plain data: it is pickled)."""
+
+    links: list[str]
+    pairs: list[tuple[int, int]]
+    unsampled: set[int]
+    counts: np.ndarray
+    home_hits: set[int]
+    limit_hits: dict[int, list[str]]
+    limit_configurations: int
+    dof: int
+    elapsed_s: float
+    jobs: int
+
+
+def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, always_threshold: float) -> MatrixRun:
+    """The self-collision matrix of ``model``; UserError when it has fewer than two links with
+    collision geometry (the matrix would be empty)."""
+    from ar3cli.sim.adjacency import adjacent_pairs, collision_links
+    from ar3cli.sim.session import run_pybullet
+
+    if len(collision_links(model)) < 2:
+        raise UserError(no_pairs_message(model))
+    counted = run_pybullet(lambda: _count(model, samples, seed, jobs), model)
+    adjacent = adjacent_pairs(model, counted.links)
+    results = cm.classify(counted.links, counted.pairs, counted.counts, samples, adjacent, counted.home_hits,
+                          counted.limit_hits, always_threshold, counted.unsampled)
+    return MatrixRun(links=counted.links, pairs=counted.pairs, results=results,
+                     warnings=cm.findings(model, results, counted.links, always_threshold), samples=samples,
+                     seed=seed, jobs=counted.jobs, limit_configurations=counted.limit_configurations,
+                     dof=counted.dof, elapsed_s=counted.elapsed_s, always_threshold=always_threshold,
+                     unsampled=counted.unsampled)
+
+
+def _count(model: Model, samples: int, seed: int, jobs: int | None) -> _Counted:
+    """In the pybullet child: home and limit configurations, then the uniform samples, timed."""
+    from ar3cli.collisions.checker import SAMPLES_PER_WORKER, Checker, count_collisions
+    from ar3cli.infra.process_pool import worker_count
+    from ar3cli.output.progress import progress_bar
+    from ar3cli.sim.sampling import limit_configurations, sample_configurations
+
+    with Checker(model) as checker:
+        space = checker.joint_space()
+        home_hits: set[int] = set()
+        limit_hits: dict[int, list[str]] = {}
+        limits = limit_configurations(space)
+        for label, q in limits:
+            for pair_id in checker.colliding(q):
+                if label == "home":
+                    home_hits.add(pair_id)
+                else:
+                    limit_hits.setdefault(pair_id, []).append(label)
+        configs = sample_configurations(space, samples, seed)
+        with progress_bar("sampling", samples) as advance:
+            start = time.perf_counter()
+            counts = count_collisions(checker, configs, jobs, progress=advance)
+            elapsed = time.perf_counter() - start
+        return _Counted(checker.links, checker.pairs, checker.unsampled, counts, home_hits, limit_hits, len(limits),
+                        space.dof, elapsed, worker_count(jobs, samples, SAMPLES_PER_WORKER))
+
+
+def no_pairs_message(model: Model) -> str:
+    """Why there is no matrix: which links lack <collision> geometry, and what to do."""
+    from ar3cli.sim.adjacency import collision_links
+
+    solid = collision_links(model)
+    visual_only = [link.name for link in model.links if link.visuals and link.name not in solid]
+    if not solid:
+        what = "no link has <collision> geometry"
+    else:
+        what = f"only one link ({solid[0]}) has <collision> geometry"
+    if visual_only:
+        what += f"; {len(visual_only)} link(s) have only <visual> ({', '.join(visual_only[:4])}" \
+                f"{', ...' if len(visual_only) > 4 else ''}), which never collide"
+    return (f"{model.path}: {what}, so there is no pair to check and the collision matrix would be empty; "
+            "add <collision> elements (e.g. a copy of each <visual> geometry)")
