@@ -11,7 +11,6 @@ from lxml import etree
 
 from ar3cli.collisions import matrix as cm
 from ar3cli.collisions.checker import Checker, count_collisions
-from ar3cli.infra.process_pool import can_fork
 from ar3cli.sim.adjacency import adjacent_pairs, direct_parent_child
 from ar3cli.sim.sampling import limit_configurations, sample_configurations
 from ar3cli.sim.session import PENETRATION_TOLERANCE, Session
