@@ -14,7 +14,7 @@ def test_json_is_clean_and_ok(cli):
     assert data["ok"] is True
     names = [check["name"] for check in data["checks"]]
     for expected in ("python", "pybullet", "numpy", "physics", "determinism", "pybullet_data", "xacro",
-                     "yourdfpy", "trimesh", "typer", "rich", "conda/pip", "renderer"):
+                     "trimesh", "typer", "rich", "conda/pip", "renderer"):
         assert expected in names
     assert all(set(check) == {"name", "status", "detail", "hint"} for check in data["checks"])
     assert all(check["status"] in {"ok", "warn", "fail", "info"} for check in data["checks"])

@@ -196,7 +196,6 @@ CHECKS: list[Callable[[], Check]] = [
     check_determinism,
     check_pybullet_data,
     check_import("xacro", "xacro"),
-    check_import("yourdfpy", "yourdfpy"),
     check_import("trimesh", "trimesh"),
     check_import("typer", "typer"),
     check_import("rich", "rich"),

@@ -4,7 +4,7 @@ The Model keeps the parsed lxml tree (each element knows its source line), typed
 joints, inertials and geometry, mesh URIs resolved to paths (with the places tried), and the
 :class:`~ar3cli.urdf.xmlsource.Quirk` list of everything odd about the file. Values that do not parse
 are kept as ``None`` next to their raw text, so the linter can report them while the other
-commands still load the file. Nothing here imports pybullet, trimesh or yourdfpy.
+commands still load the file. Nothing here imports pybullet or trimesh.
 """
 
 from __future__ import annotations
