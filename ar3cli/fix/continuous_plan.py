@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped, number
+from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
 from ar3cli.fix.edits import Document
 
 FULL_TURN = 2.0 * math.pi
@@ -165,10 +165,8 @@ def _remove_fake_limits(document: Document, plan: FixPlan, joint, options: Conti
 
 
 def _same(old: str | None, new: str) -> bool:
-    try:
-        return old is not None and math.isclose(float(old), float(new), rel_tol=1e-12, abs_tol=0.0)
-    except ValueError:
-        return False
+    """A limit from joint_limits.yaml equals the file's to 1e-12 (relative)."""
+    return same_numbers(old, new, rel_tol=1e-12)
 
 
 def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, options: ContinuousOptions) -> None:

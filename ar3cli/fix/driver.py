@@ -12,6 +12,7 @@ xacro, builds the new bytes, checks they still parse, prints a diff (``--diff``)
 from __future__ import annotations
 
 import difflib
+import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -80,6 +81,19 @@ class FixResult:
         if self.diff:
             data["diff"] = self.diff
         return data
+
+
+def same_numbers(old: str | None, new: str, rel_tol: float, abs_tol: float = 0.0) -> bool:
+    """True when the old attribute text already says the new numbers (so nothing is rewritten):
+    same count of whitespace-separated numbers, each equal within the tolerances."""
+    if old is None:
+        return False
+    try:
+        a = [float(x) for x in old.split()]
+        b = [float(x) for x in new.split()]
+    except ValueError:
+        return False
+    return len(a) == len(b) and all(math.isclose(x, y, rel_tol=rel_tol, abs_tol=abs_tol) for x, y in zip(a, b))
 
 
 def number(value: float) -> str:

@@ -26,7 +26,7 @@ import numpy as np
 
 from ar3cli.errors import UserError
 from ar3cli.fix import geometry_mass as inertia
-from ar3cli.fix.driver import Change, FixPlan, Skipped, number
+from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
 from ar3cli.fix.edits import Document
 from ar3cli.lint.rules.inertia import inertia_implausible
 from ar3cli.physics import mass_properties as mp
@@ -283,15 +283,8 @@ def _set(document: Document, plan: FixPlan, element, attribute: str, value: str,
 
 
 def _same_numbers(old: str | None, new: str) -> bool:
-    """True when the old text already says the new numbers (so nothing is rewritten)."""
-    if old is None:
-        return False
-    try:
-        a = [float(x) for x in old.split()]
-        b = [float(x) for x in new.split()]
-    except ValueError:
-        return False
-    return len(a) == len(b) and all(math.isclose(x, y, rel_tol=1e-9, abs_tol=1e-15) for x, y in zip(a, b))
+    """A computed number equals the file's to 1e-9 (relative) or 1e-15 (absolute, for zeros)."""
+    return same_numbers(old, new, rel_tol=1e-9, abs_tol=1e-15)
 
 
 def _clean(values: np.ndarray, relative: float = 0.0, absolute: float = 0.0) -> np.ndarray:
