@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import struct
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -102,3 +103,23 @@ def test_disk_cache_reuses_and_invalidates(tmp_path, monkeypatch):
     assert fresh_bounds() == ((0.0, 0.0, 0.0), (5.0, 5.0, 5.0))  # a damaged cache is ignored
     monkeypatch.setenv("AR3CLI_NO_CACHE", "1")
     assert cache.cache_dir() is None
+
+
+def test_collada_bounds_follow_the_scene_and_skip_unused_positions() -> None:
+    """ar3cli's own COLLADA reader: node transforms (translate, rotate, scale, matrix, nesting),
+    only the positions the triangles use; the same box as trimesh."""
+    import numpy as np
+    import trimesh
+
+    from ar3cli.urdf.dae import dae_bounds
+
+    path = Path(__file__).parent / "data" / "meshes" / "transformed.dae"
+    low, high = dae_bounds(path)
+    # moved: the square scaled by 2 and turned 90 degrees about z -> x in [-2, 0], y in [0, 2], z = 2;
+    # matrixed/child: shifted to x in [5, 6], z = -1.
+    assert low == pytest.approx((-2.0, 0.0, -1.0), abs=1e-12)
+    assert high == pytest.approx((6.0, 2.0, 2.0), abs=1e-12)
+    with path.open("rb") as handle:
+        vertices = np.asarray(trimesh.load(handle, file_type="dae", force="mesh", process=False).vertices)
+    assert low == pytest.approx(tuple(vertices.min(axis=0)), abs=1e-6)
+    assert high == pytest.approx(tuple(vertices.max(axis=0)), abs=1e-6)

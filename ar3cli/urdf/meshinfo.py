@@ -98,8 +98,10 @@ def _mesh_bounds(path: Path, _mtime_ns: int, size: int) -> Bounds | None:
             parsed = _stl_columns(data)
         elif suffix == ".obj":
             parsed = _obj_columns(path.read_bytes())
+        elif suffix == ".dae":
+            return _dae_bounds(path)
         else:
-            parsed = _trimesh_columns(path)
+            return _trimesh_bounds(path)
     except Exception:  # noqa: BLE001 - a mesh we cannot read is the loader's problem, not a reason to crash the lint
         return None
     return _bounds(*parsed) if parsed is not None else None
@@ -185,11 +187,4 @@ def _numpy_stl_bounds(data: bytes) -> Bounds | None:
     return tuple(vertices.min(axis=0).tolist()), tuple(vertices.max(axis=0).tolist())  # type: ignore[return-value]
 
 
-def _trimesh_columns(path: Path) -> tuple[Columns, bool] | None:
-    import trimesh
 
-    loaded = trimesh.load(str(path), force="mesh", process=False)
-    vertices = getattr(loaded, "vertices", None)
-    if vertices is None or len(vertices) == 0:
-        return None
-    return tuple(vertices.T.tolist()), True  # type: ignore[return-value]
