@@ -326,3 +326,15 @@ def _two_link_urdf(inertial_xyz: str = "0 0 0", mimic: bool = False, prismatic_a
 {finger}
 </robot>
 """
+
+
+def test_tree_order_survives_a_loop_and_long_chains(write_urdf) -> None:
+    """A joint leading back to a link already reached is skipped (it used to loop forever)."""
+    from ar3cli.kinematics.fk import tree_order
+
+    links = "".join(f'<link name="l{i}"/>' for i in range(4))
+    joints = "".join(f'<joint name="j{i}" type="fixed"><parent link="l{i}"/><child link="l{i + 1}"/></joint>'
+                     for i in range(3))
+    loop = '<joint name="back" type="fixed"><parent link="l3"/><child link="l1"/></joint>'
+    model = load_model(write_urdf(f'<robot name="r">{links}{joints}{loop}</robot>'))
+    assert [joint.name for joint in tree_order(model)] == ["j0", "j1", "j2"]

@@ -97,15 +97,27 @@ def joint_motion(joint: Joint, values: np.ndarray) -> np.ndarray:
 
 
 def tree_order(model: Model) -> list[Joint]:
-    """Joints in parent-before-child order from the single root link."""
+    """Joints in parent-before-child order from the single root link.
+
+    Each link is entered once: a joint leading back to a link already reached (a loop, lint's
+    S-rules) is left out instead of looping forever. Children are grouped by parent in one pass,
+    so a long chain costs O(joints), not O(links x joints).
+    """
+    children: dict[str | None, list[Joint]] = {}
+    for joint in model.joints:
+        children.setdefault(joint.parent, []).append(joint)
     order: list[Joint] = []
-    stack = [model.root_link.name]
+    root = model.root_link.name
+    seen = {root}
+    stack = [root]
     while stack:
         link = stack.pop()
-        for joint in reversed(model.child_joints(link)):
+        for joint in reversed(children.get(link, [])):
+            if joint.child is None or joint.child in seen:
+                continue
+            seen.add(joint.child)
             order.append(joint)
-            if joint.child is not None:
-                stack.append(joint.child)
+            stack.append(joint.child)
     return order
 
 
