@@ -15,6 +15,7 @@ from ar3cli.commands.fix_continuous import fix_continuous
 from ar3cli.commands.fix_inertia import fix_inertia
 from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.commands.grasp_demo import grasp_demo
+from ar3cli.commands.info import info
 from ar3cli.commands.install_check import install_check
 from ar3cli.commands.lint_urdf import lint_urdf
 from ar3cli.commands.render import render_command
@@ -47,6 +48,7 @@ def _root(
 
 
 app.command("install-check")(install_check)
+app.command("info")(info)
 app.command("render")(render_command)
 app.command("fk-verify")(fk_verify)
 app.command("lint-urdf")(lint_urdf)

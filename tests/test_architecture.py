@@ -20,7 +20,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("application", ["cli"]),
     ("commands", ["commands"]),
     ("fixers", ["fix"]),
-    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor"]),
+    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor", "info"]),
     ("simulation", ["sim"]),
     ("robot files", ["urdf"]),
     ("maths", ["physics"]),
@@ -114,6 +114,20 @@ def test_no_import_cycles() -> None:
         if state[module] == 0:
             visit(module, [module])
     assert not cycles, "import cycles:\n" + "\n".join(cycles)
+
+
+HEAVY = ("pybullet", "numpy", "trimesh", "yourdfpy", "rich", "lxml", "xacro", "PIL", "yaml")
+
+
+def test_importing_the_cli_loads_no_heavy_library() -> None:
+    """Every command module is imported at start-up: each imports its heavy libraries inside the
+    function that needs them (docs/architecture.md, "Start-up budget")."""
+    import subprocess
+
+    code = f"import sys, ar3cli.cli; print(sorted(m for m in {HEAVY!r} if m in sys.modules))"
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=PACKAGE.parent)
+    assert result.returncode == 0, result.stderr
+    assert result.stdout.strip() == "[]"
 
 
 def test_ruff_is_clean() -> None:

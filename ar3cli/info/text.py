@@ -1,0 +1,202 @@
+"""``ar3cli info``'s report: the JSON document, and for people the joint and mass tables, the
+kinematic tree (a rich Tree) and a few summary lines."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ar3cli.info.summary import JointInfo, Summary
+from ar3cli.output.report import Report, Table, format_cell
+
+ONE_LINE_LIST = 12
+"""Name lists longer than this are cut in the summary lines (the JSON has them all)."""
+
+
+def report(summary: Summary, tree: bool = True) -> Report:
+    """The Report for ``summary``; ``tree=False`` leaves the rich Tree out (JSON needs no rich)."""
+    return Report(data=summary.to_dict(), tables=[joint_table(summary), mass_table(summary)],
+                  renderables=[kinematic_tree(summary)] if tree else [], lines=summary_lines(summary))
+
+
+def joint_table(summary: Summary) -> Table:
+    rows = []
+    for joint in summary.movable_joints:
+        low, high = ("unlimited", "unlimited") if joint.unlimited else (joint.lower, joint.upper)
+        rows.append([joint.name, joint.type, _axis(joint), low, high, joint.effort, joint.velocity, _mimic(joint)])
+    return Table(title=f"movable joints ({len(rows)}, DOF {summary.dof}; rad or m, N m or N, rad/s or m/s)",
+                 columns=["joint", "type", "axis", "lower", "upper", "effort", "velocity", "note"], rows=rows,
+                 numeric_columns=("lower", "upper", "effort", "velocity"))
+
+
+def mass_table(summary: Summary) -> Table:
+    total = summary.total_mass
+    rows = [[link.name, link.mass, _share(link.mass, total), link.mass_note] for link in summary.links]
+    return Table(title=f"link masses (total {total:.4g} kg)", columns=["link", "mass (kg)", "share", "note"],
+                 rows=rows, numeric_columns=("mass (kg)", "share"))
+
+
+def kinematic_tree(summary: Summary) -> Any:
+    """A rich Tree: each root link, and under each link the joints leading to its children."""
+    from rich.text import Text
+    from rich.tree import Tree
+
+    children: dict[str | None, list[JointInfo]] = {}
+    for joint in summary.joints:
+        children.setdefault(joint.parent, []).append(joint)
+    title = f"kinematic tree of {summary.name or summary.path.name}"
+    top = Tree(Text(title, style="bold"), guide_style="dim")
+    seen: set[str] = set()
+
+    def grow(node: Any, link: str) -> None:
+        """Iterative, not recursive: a chain of thousands of links (a rope, a snake) stays fine."""
+        stack = [(node, link)]
+        seen.add(link)
+        while stack:
+            node, link = stack.pop()
+            branches = []
+            for joint in children.get(link, []):
+                child = joint.child or "?"
+                loop = child in seen
+                branch = node.add(Text(f"{child}  ({_joint_label(joint)})" + ("  [loop]" if loop else "")))
+                if not loop:
+                    seen.add(child)
+                    branches.append((branch, child))
+            stack += reversed(branches)
+
+    for root in summary.roots:
+        grow(top.add(Text(f"{root}  (root)")), root)
+    for name in summary.unreachable:
+        if name not in seen:
+            grow(top.add(Text(f"{name}  (not reachable from the root)")), name)
+    return top
+
+
+def summary_lines(summary: Summary) -> list[str]:
+    roots = ", ".join(summary.roots) or "none"
+    lines = [f"{summary.name or '(no name)'} ({summary.path}): {_count(len(summary.links), 'link')}, "
+             f"{_count(len(summary.joints), 'joint')}, "
+             f"root link{'s' if len(summary.roots) != 1 else ''} {roots}"]
+    movable = summary.movable_joints
+    by_type: dict[str, int] = {}
+    for joint in movable:
+        by_type[joint.type] = by_type.get(joint.type, 0) + 1
+    kinds = ", ".join(f"{count} {kind}" for kind, count in by_type.items())
+    mimics = sum(1 for joint in movable if joint.mimic is not None and joint.dof == 0)
+    lines.append(f"DOF {summary.dof}: {_count(len(movable), 'movable joint')}" + (f" ({kinds})" if kinds else "")
+                 + (f", of which {mimics} mimic (following another joint, no DOF of their own)" if mimics else ""))
+    massless = summary.massless_links
+    detail = (f"; {_count(len(massless), 'link')} counted as 0: " + _names([f"{link.name} ({link.mass_note})"
+                                                                    for link in massless])) if massless else ""
+    lines.append(f"total mass {summary.total_mass:.4g} kg{detail}")
+    root = summary.roots[0] if len(summary.roots) == 1 else "the root link"
+    if summary.centre_of_mass is not None:
+        lines.append(f"centre of mass at the zero configuration: {_point(summary.centre_of_mass)} m "
+                     f"(in {root}'s frame)")
+    else:
+        lines.append("centre of mass: n/a")
+    box = summary.bounding_box
+    if box is not None:
+        extent = ", ".join(f"{axis} {_metres(low)} .. {_metres(high)}" for axis, low, high in zip("xyz", box.low, box.high))
+        size = " x ".join(map(_metres, box.size))
+        left_out = ""
+        if box.shapes_left_out:
+            left_out = (f"; covers only {box.shapes} of {box.shapes + box.shapes_left_out} shapes (the others are of "
+                        "unknown size: unresolved or unreadable meshes)")
+        geometry = "visual geometry"
+        if box.collision_links:
+            geometry += f"; collision geometry for {_count(len(box.collision_links), 'link')}"
+        lines.append(f"bounding box at the zero configuration ({geometry}): {extent} m; size {size} m{left_out}")
+    else:
+        lines.append("bounding box: n/a (no shape of known size was placed)")
+    lines.append(_mesh_line(summary))
+    unresolved = summary.meshes.unresolved
+    if unresolved:
+        problems = "; ".join(dict.fromkeys(item["problem"] for item in unresolved))
+        lines.append(f"unresolved meshes ({len(unresolved)} of {summary.meshes.files} files: {problems}): "
+                     + _names([item["uri"] for item in unresolved], most=3)
+                     + ("" if len(unresolved) <= 3 else "; --format json lists them all"))
+    leaves = summary.end_effectors
+    lines.append(f"end effectors (leaf links, {len(leaves)}): {_names(leaves) or 'none'}")
+    if summary.unreachable:
+        lines.append(f"not reachable from the root ({len(summary.unreachable)}): {_names(summary.unreachable)}")
+    lines += [f"note: {note}" for note in summary.notes]
+    return lines
+
+
+def _mesh_line(summary: Summary) -> str:
+    facts = summary.meshes
+    if not facts.references:
+        return "meshes: none"
+    formats = ", ".join(f"{count} {kind}" for kind, count in facts.formats.items())
+    line = f"meshes: {_count(facts.references, 'reference')} to {_count(facts.files, 'file')} ({formats})"
+    if facts.lfs_pointers:
+        line += f"; {len(facts.lfs_pointers)} are Git LFS pointers (run git lfs pull)"
+    counted = facts.counted_files
+    if facts.triangles is None:
+        line += "; triangles n/a (counted for binary STL only)"
+    else:
+        roles = ", ".join(f"{role} {count:,}" for role, count in facts.triangles_by_role.items() if count is not None)
+        scope = "" if counted == facts.files else f" in {counted} of {facts.files} files, counted for binary STL only"
+        line += f"; {facts.triangles:,} triangles ({roles}){scope}"
+    return line
+
+
+def _joint_label(joint: JointInfo) -> str:
+    parts = [f"{joint.name}: {joint.type}"]
+    if joint.axis is not None and joint.type != "fixed":
+        parts.append(f"axis {_axis(joint)}")
+    if joint.unlimited:
+        parts.append("unlimited")
+    elif joint.type in ("revolute", "prismatic"):
+        if joint.lower is None and joint.upper is None:
+            parts.append("no limits")
+        else:
+            unit = "rad" if joint.type == "revolute" else "m"
+            parts.append(f"{format_cell(joint.lower)} .. {format_cell(joint.upper)} {unit}")
+    if joint.mimic is not None:
+        parts.append(_mimic(joint))
+    return ", ".join(parts)
+
+
+def _axis(joint: JointInfo) -> str:
+    if joint.axis is None:
+        return ""
+    text = " ".join(f"{v:g}" for v in joint.axis)
+    return text if joint.axis_given else f"{text} (default)"
+
+
+def _mimic(joint: JointInfo) -> str:
+    if joint.mimic is None:
+        return ""
+    text = f"follows {joint.mimic['joint']}"
+    if joint.mimic["multiplier"] != 1.0:
+        text += f" x {joint.mimic['multiplier']:g}"
+    if joint.mimic["offset"] != 0.0:
+        text += f" {'+' if joint.mimic['offset'] > 0 else '-'} {abs(joint.mimic['offset']):g}"
+    if joint.dof:
+        text += " (no such joint: counted as a DOF)"
+    return text
+
+
+def _share(mass: float | None, total: float) -> str:
+    return f"{100 * mass / total:.1f}%" if mass is not None and total > 0 else "-"
+
+
+def _metres(value: float) -> str:
+    """0.1 mm resolution; a rounding to zero drops its sign."""
+    text = f"{value:.4f}"
+    return text[1:] if text == "-0.0000" else text
+
+
+def _point(values) -> str:
+    return "(" + ", ".join(map(_metres, values)) + ")"
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{number} {noun}" if number == 1 else f"{number} {noun}s"
+
+
+def _names(names: list[str], most: int = ONE_LINE_LIST) -> str:
+    if len(names) <= most:
+        return ", ".join(names)
+    return ", ".join(names[:most]) + f", ... ({len(names) - most} more)"
