@@ -93,6 +93,14 @@ def test_github_format_writes_step_summary(cli, tmp_path):
     assert "&lt;inertial&gt;" in text and "<inertial>" not in text  # not swallowed as an HTML tag
 
 
+def test_unwritable_step_summary_is_one_error_after_the_annotations(cli, tmp_path):
+    example = str(ASSETS / "examples" / "ar3_no_inertia.urdf")
+    result = cli("lint-urdf", example, "--format", "github", env={"GITHUB_STEP_SUMMARY": str(tmp_path)})  # a folder
+    assert result.code == 2 and result.stdout.count("::error file=") == 3
+    assert result.stderr.startswith("ar3cli: error: cannot append to $GITHUB_STEP_SUMMARY") and "Traceback" not in result.stderr
+    assert cli("lint-urdf", example, "--format", "github", env={"GITHUB_STEP_SUMMARY": ""}).code == 1
+
+
 def test_select_and_ignore(cli, write_urdf):
     path = str(write_urdf(NO_LIMIT))
     ignored = json.loads(cli("lint-urdf", path, "--ignore", "J001", "--format", "json").stdout)
@@ -158,7 +166,8 @@ def test_folders_are_searched_and_xacro_expanded(cli, tmp_path):
     doc = json.loads(cli("lint-urdf", str(tmp_path), "--format", "json").stdout)
     assert [Path(f["path"]).name for f in doc["files"]] == ["a.urdf", "b.urdf.xacro"]
     j008 = [f for f in doc["findings"] if f["rule"] == "J008"]
-    assert len(j008) == 1 and j008[0]["line"] == 6  # mapped back to the joint in the xacro source
+    assert len(j008) == 1 and (j008[0]["line"], j008[0]["column"]) == (7, 5)  # the <limit> in the xacro source
+    assert j008[0]["path"] == str(tmp_path / "sub" / "b.urdf.xacro")
     with_arg = json.loads(cli("lint-urdf", str(tmp_path / "sub" / "b.urdf.xacro"), "--xacro-arg", "effort:=5",
                               "--format", "json").stdout)
     assert with_arg["findings"] == []

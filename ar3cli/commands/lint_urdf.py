@@ -1,7 +1,6 @@
 """``ar3cli lint-urdf``: static (and optionally simulated) checks of URDF / xacro files."""
 
 import enum
-import os
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -58,6 +57,11 @@ def lint_urdf(
     no_cache: Annotated[bool, typer.Option("--no-cache", help="Check every file again instead of reusing the "
                                                               "findings of unchanged files from earlier runs "
                                                               "(also AR3CLI_NO_CACHE=1).")] = False,
+    group: Annotated[Optional[bool], typer.Option("--group/--no-group",
+                                                  help="Text format: show 5 or more alike findings of one rule in "
+                                                       "one file as one row (count, first locations, message); on "
+                                                       "by default. JSON, SARIF, github and markdown keep every "
+                                                       "finding.", show_default=False)] = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
 ) -> None:
@@ -87,9 +91,10 @@ def lint_urdf(
     if not results:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     summary = summarize(results, threshold)
-    report = render_lint(results, summary, options, LintFormat(format))
+    grouped = True if group is None else group
+    report = render_lint(results, summary, options, LintFormat(format), grouped=grouped)
     report.ok = report.ok or exit_zero
-    report.errors = [result.error for result in results if result.error]
+    report.errors = [*report.errors, *(result.error for result in results if result.error)]
     finish(report, "json" if LintFormat(format) in (LintFormat.json, LintFormat.sarif) else "text")
 
 
@@ -108,10 +113,11 @@ def summary_line(summary: dict) -> str:
             f"(fail-on: {summary['fail_on']})")
 
 
-def render_lint(results, summary: dict, options, fmt: LintFormat) -> Report:
+def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool = False) -> Report:
     """The lint Report in ``fmt``: text and json tables, SARIF as the JSON document, github
     annotations and markdown as verbatim stdout text (github also appends the Markdown table to
-    ``$GITHUB_STEP_SUMMARY`` when set)."""
+    ``$GITHUB_STEP_SUMMARY`` when set). ``grouped`` folds alike findings into one text row
+    (:func:`~ar3cli.lint.engine.group_findings`); every other format keeps every finding."""
     findings = [f for result in results for f in result.findings]
     data = {"files": [r.to_dict() for r in results], "findings": [f.to_dict() for f in findings], "summary": summary}
     ok = not summary["failed"]
@@ -120,19 +126,31 @@ def render_lint(results, summary: dict, options, fmt: LintFormat) -> Report:
 
         return Report(data=sarif_document(findings, options.rules()), ok=ok)
     if fmt in (LintFormat.github, LintFormat.markdown):
-        from ar3cli.output.github import annotation, markdown_table
+        from ar3cli.output.github import annotation, append_step_summary, markdown_table
 
         table = markdown_table(findings, summary_line(summary))
         if fmt is LintFormat.markdown:
             return Report(data=data, text=table, ok=ok)
-        step_summary = os.environ.get("GITHUB_STEP_SUMMARY")
-        if step_summary:  # GitHub Actions: the reviewer sees the table on the run's summary page
-            with open(step_summary, "a", encoding="utf-8") as handle:
-                handle.write(table)
+        error = append_step_summary(table)  # GitHub Actions: the reviewer sees it on the run's summary page
         annotations = "".join(annotation(finding) + "\n" for finding in findings)
-        return Report(data=data, text=annotations + summary_line(summary) + "\n", ok=ok)
+        return Report(data=data, text=annotations + summary_line(summary) + "\n", ok=ok, errors=[error] if error else [])
     tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
-                    rows=[[f.location, f.rule, f.severity.value, f.message, f.hint] for f in result.findings],
-                    status_column="severity", nowrap_columns=("location",))
+                    rows=_rows(result.findings, grouped), status_column="severity", nowrap_columns=("location",))
               for result in results if result.findings]
     return Report(data=data, tables=tables, lines=[summary_line(summary)], ok=ok)
+
+
+def _rows(findings, grouped: bool) -> list[list]:
+    """Table rows: one per finding, or per group of alike findings when ``grouped``."""
+    if not grouped:
+        return [[f.location, f.rule, f.severity.value, f.message, f.hint] for f in findings]
+    from ar3cli.lint.engine import FindingGroup, group_findings
+
+    rows = []
+    for row in group_findings(findings):
+        if isinstance(row, FindingGroup):
+            first = row.first
+            rows.append([first.location, first.rule, first.severity.value, row.message, first.hint])
+        else:
+            rows.append([row.location, row.rule, row.severity.value, row.message, row.hint])
+    return rows

@@ -200,14 +200,14 @@ def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> L
             findings += run_pybullet(lambda: _run_rules(model, shown, simulated, options), model)
         except CrashError as exc:
             error = exc.message
-    findings.sort(key=lambda f: (f.line, f.column, f.rule))
+    findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
 
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
     """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
     context = Context(model)
-    locator = Locator(model)
+    locator = Locator(model, shown)
     file_ignores = _file_level_ignores(model.source_bytes)
     findings: list[Finding] = []
     try:
@@ -219,8 +219,10 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> li
                     continue
                 if hit.element is not None and suppressed_inline(hit.element, rule.code):
                     continue
-                line, column = locator.locate(hit)
-                findings.append(_override(Finding(rule.code, rule.severity, hit.message, shown, line, column,
+                path, line, column = locator.locate(hit)
+                if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
+                    continue
+                findings.append(_override(Finding(rule.code, rule.severity, hit.message, path, line, column,
                                                   hit.hint or rule.fix), options))
     finally:
         context.close()
@@ -250,31 +252,71 @@ def load_failure(path: Path, shown: str, message: str) -> Finding:
 
 
 class Locator:
-    """Line and column of a hit: in the parsed text, or mapped back into the .xacro source."""
+    """File, line and column of a hit: in the parsed text, or, for a .xacro file, where the element
+    was written: the top file, or the included file whose macro or text produced it."""
 
-    def __init__(self, model) -> None:
+    def __init__(self, model, shown: str) -> None:
         self.model = model
+        self.shown = shown
         self._source_text: str | None = None
+        self._origins: dict[Any, Any] | None = None
+        self._files: dict[str, str] = {}
 
-    def locate(self, hit: Hit) -> tuple[int, int]:
+    def locate(self, hit: Hit) -> tuple[str, int, int]:
         element = hit.element
         if element is None:
-            return hit.line, (1 if hit.line else 0)
+            return self.shown, hit.line, (1 if hit.line else 0)
         if not self.model.is_xacro:
             line = element.sourceline or 0
-            return line, (self.model.column_of(element) if line else 0)
-        return self._xacro_position(element)
+            return self.shown, line, (self.model.column_of(element) if line else 0)
+        origins = self._element_origins()
+        if origins:
+            # The element itself, where its text was written (as for a .urdf); an element xacro
+            # made itself takes its nearest ancestor's origin.
+            node = element
+            while node is not None:
+                origin = origins.get(node)
+                if origin is not None:
+                    return self._file(origin.file), origin.line, origin.column
+                node = node.getparent()
+        return (self.shown, *self._xacro_position(element))
+
+    def _element_origins(self) -> dict[Any, Any]:
+        """Each element of the expanded tree -> its :class:`~ar3cli.urdf.xacro_expand.Origin`
+        (empty when the expansion's origins are unknown or do not match the tree)."""
+        if self._origins is None:
+            from ar3cli.urdf.xacro_expand import origins
+
+            found = origins(self.model.xml_bytes) or []
+            elements = [node for node in self.model.root.iter() if isinstance(node.tag, str)]
+            self._origins = dict(zip(elements, found)) if len(found) == len(elements) else {}
+        return self._origins
+
+    def _file(self, file: str) -> str:
+        """The display path of a file xacro read: the linted file as shown, an included one
+        relative to the current directory (``a/../b`` folded when it is the same file)."""
+        if file not in self._files:
+            if file == str(self.model.path):
+                shown = self.shown
+            else:
+                folded = os.path.normpath(file)
+                try:
+                    same = folded == file or os.path.samefile(folded, file)
+                except OSError:
+                    same = False
+                shown = display_path(Path(folded if same else file))
+            self._files[file] = shown
+        return self._files[file]
 
     def _xacro_position(self, element) -> tuple[int, int]:
-        """Position of the enclosing link/joint (by its name) in the xacro source; (0, 0) if ambiguous."""
+        """Position of the enclosing link/joint (by its name) in the xacro source; (0, 0) if ambiguous.
+        Used only when the expansion's origins are unknown."""
         from ar3cli.urdf.xmlsource import decode_text
 
         if self._source_text is None:
             self._source_text = decode_text(self.model.source_bytes)
-        node = element
-        while node is not None and not (node.tag in ("link", "joint") and node.get("name")):
-            node = node.getparent()
-        if node is None:
+        node = _enclosing_link_or_joint(element)
+        if node is element and not (node.tag in ("link", "joint") and node.get("name")):
             pattern = r"<robot\b"
         else:
             pattern = rf"""<{node.tag}\b[^>]*?\bname\s*=\s*["']{re.escape(node.get("name"))}["']"""
@@ -285,6 +327,13 @@ class Locator:
         line = self._source_text.count("\n", 0, start) + 1
         return line, start - (self._source_text.rfind("\n", 0, start) + 1) + 1
 
+
+def _enclosing_link_or_joint(element):
+    """The named <link> or <joint> holding ``element`` (or being it); else ``element``."""
+    node = element
+    while node is not None and not (node.tag in ("link", "joint") and node.get("name")):
+        node = node.getparent()
+    return element if node is None else node
 
 
 def _file_ignored(shown: str, code: str, options: LintOptions) -> bool:
@@ -327,6 +376,68 @@ def _override(finding: Finding, options: LintOptions) -> Finding:
     if severity is None or severity == finding.severity:
         return finding
     return Finding(finding.rule, severity, finding.message, finding.path, finding.line, finding.column, finding.hint)
+
+
+GROUP_AT = 5
+"""From this many findings of one rule in one file, alike but for names and numbers, the text
+table shows one row for them (Talos: 93 G002 rows, one per mesh URI, become one). A few stay one
+per row: three links without <inertial> are worth naming one by one."""
+GROUP_LOCATIONS = 3
+"""Locations a grouped row lists."""
+_VARIABLE = re.compile(r"""'[^']*'|"[^"]*"|[^\s'"]*[/\\][^\s'"]*|[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?""")
+"""What differs between alike messages: quoted names and values, paths and URIs, numbers."""
+_VARIABLES = re.compile(r"#(?:[\s,]+#)+")
+
+
+def message_shape(message: str) -> str:
+    """``message`` with names, paths and numbers replaced by ``#`` (a run of them by one ``#``)."""
+    return _VARIABLES.sub("#", _VARIABLE.sub("#", message))
+
+
+@dataclass(frozen=True)
+class FindingGroup:
+    """Alike findings of one rule in one file, shown as one row of the text table."""
+
+    findings: tuple[Finding, ...]
+
+    @property
+    def first(self) -> Finding:
+        return self.findings[0]
+
+    @property
+    def message(self) -> str:
+        """``93x: <first message> (and 92 more like it); at 31:9, 38:9, 54:9, ...`` (without the
+        "and N more" when every message is the same)."""
+        count = len(self.findings)
+        text = f"{count}x: {self.first.message}"
+        if any(finding.message != self.first.message for finding in self.findings):
+            text += f" (and {count - 1} more like it)"
+        places = [f"{f.line}:{f.column or 1}" for f in self.findings if f.line]
+        if places:
+            text += "; at " + ", ".join(places[:GROUP_LOCATIONS]) + (", ..." if len(places) > GROUP_LOCATIONS else "")
+        return text
+
+
+def group_findings(findings: list[Finding], at_least: int = GROUP_AT) -> list[Finding | FindingGroup]:
+    """The rows of a text table: each finding, except that ``at_least`` or more findings with the
+    same file, rule, severity and message and hint shapes (:func:`message_shape`) become one
+    :class:`FindingGroup`, placed where the first of them was."""
+    def key(finding: Finding) -> tuple:
+        return (finding.path, finding.rule, finding.severity, message_shape(finding.message),
+                message_shape(finding.hint))
+
+    keys = [key(finding) for finding in findings]
+    members: dict[tuple, list[Finding]] = {}
+    for finding, finding_key in zip(findings, keys):
+        members.setdefault(finding_key, []).append(finding)
+    rows: list[Finding | FindingGroup] = []
+    for finding, finding_key in zip(findings, keys):
+        alike = members[finding_key]
+        if len(alike) < at_least:
+            rows.append(finding)
+        elif alike[0] is finding:
+            rows.append(FindingGroup(tuple(alike)))
+    return rows
 
 
 def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:

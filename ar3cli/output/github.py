@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import os
+
 from ar3cli.findings import Finding, Severity
 
 COMMANDS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "notice"}
@@ -43,3 +45,21 @@ def markdown_table(findings: list[Finding], summary_line: str) -> str:
         lines.append("")
     lines.append(summary_line)
     return "\n".join(lines) + "\n"
+
+
+def append_step_summary(markdown: str) -> str | None:
+    """Append ``markdown`` to the file ``$GITHUB_STEP_SUMMARY`` names (GitHub Actions shows it on the
+    run's summary page); nothing when the variable is unset or empty.
+
+    Returns None, or the one-line error when the file cannot be written (for ``Report.errors``:
+    the annotations are still printed, and the exit code says something went wrong).
+    """
+    path = os.environ.get("GITHUB_STEP_SUMMARY")
+    if not path:
+        return None
+    try:
+        with open(path, "a", encoding="utf-8") as handle:
+            handle.write(markdown)
+    except OSError as exc:
+        return f"cannot append to $GITHUB_STEP_SUMMARY ({path}): {exc.strerror or exc}"
+    return None
