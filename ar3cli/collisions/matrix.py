@@ -14,7 +14,8 @@ Categories, in MoveIt's order of precedence (``compute_default_collisions.cpp``)
 5. ``sometimes``: everything else, with the fraction and a Wilson 95% interval. Kept enabled.
 
 The first four are the pairs MoveIt disables (``<disable_collisions reason="Adjacent|Default|
-Always|Never"/>``) and the pairs to pass to ``setCollisionFilterPair`` in PyBullet.
+Always|Never"/>``, written, merged and compared by :mod:`ar3cli.collisions.srdf`) and the pairs to
+pass to ``setCollisionFilterPair`` in PyBullet.
 """
 
 from __future__ import annotations
@@ -28,7 +29,7 @@ from ar3cli.findings import Finding, Severity
 from ar3cli.sim.adjacency import direct_parent_child
 from ar3cli.urdf.model import Model
 
-__all__ = ["classify", "findings", "srdf_bytes"]
+__all__ = ["classify", "findings", "pybullet_filter_bytes"]
 
 CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
 DISABLED = ("adjacent", "default", "always", "never")
@@ -177,19 +178,6 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
 # ---- export -------------------------------------------------------------------------------------
 def disabled_pairs(results: Iterable[PairResult]) -> list[PairResult]:
     return [result for result in results if result.category in DISABLED]
-
-
-def srdf_bytes(robot_name: str, results: Sequence[PairResult], comment: str = "") -> bytes:
-    """An SRDF with one ``<disable_collisions link1 link2 reason/>`` per disabled pair, MoveIt-style."""
-    from lxml import etree
-
-    root = etree.Element("robot", name=robot_name or "robot")
-    if comment:
-        root.append(etree.Comment(f" {comment} "))
-    for result in disabled_pairs(results):
-        etree.SubElement(root, "disable_collisions", link1=result.link_a, link2=result.link_b,
-                         reason=SRDF_REASONS[result.category])
-    return etree.tostring(root, xml_declaration=True, encoding="utf-8", pretty_print=True)
 
 
 def pybullet_filter_bytes(results: Sequence[PairResult], comment: str = "") -> bytes:

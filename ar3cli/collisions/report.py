@@ -5,12 +5,16 @@ from __future__ import annotations
 
 from ar3cli.collisions import matrix as cm
 from ar3cli.collisions.run import MatrixRun
+from ar3cli.collisions.srdf import STATUSES, Comparison, Merged
 from ar3cli.output.report import OutputFormat, Report, Table
 from ar3cli.urdf.model import Model
 
 
-def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str) -> Report:
-    """Always ok: the warnings describe the robot, they do not fail the run."""
+def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str,
+                  comparison: Comparison | None = None, merged: Merged | None = None) -> Report:
+    """Always ok: the warnings describe the robot, they do not fail the run. With ``comparison``
+    (--srdf-compare) every pair carries what the existing SRDF says about it and a second table lists
+    the disagreements; with ``merged`` (--srdf-merge) a line says what the merge changed."""
     from ar3cli.sim.session import PENETRATION_TOLERANCE
 
     counts = cm.category_counts(run.results)
@@ -24,13 +28,23 @@ def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str) -> Repo
         "warnings": [finding.to_dict() for finding in run.warnings],
         "configs_per_second": run.configs_per_second, "elapsed_s": run.elapsed_s,
     }
+    if comparison is not None:
+        for pair in data["pairs"]:
+            pair["srdf"] = comparison.marks.get(frozenset((pair["link_a"], pair["link_b"])))
+        data["srdf_compare"] = comparison.to_dict()
+    if merged is not None:
+        data["srdf_merge"] = merged.to_dict()
     if OutputFormat(fmt) is OutputFormat.json:
         return Report(data=data)
     title = f"self-collision pairs of {model.path.name} ({run.samples} samples, seed {run.seed})"
-    table = Table(title=title, columns=["link a", "link b", "category", "collisions", "fraction", "95% interval",
-                                        "at home", "limit hits"],
-                  rows=[_row(result) for result in _ordered(run.results)],
-                  caption="a link and its direct parent are adjacent and not sampled (-)",
+    columns = ["link a", "link b", "category", "collisions", "fraction", "95% interval", "at home", "limit hits"]
+    rows = [_row(result) for result in _ordered(run.results)]
+    caption = "a link and its direct parent are adjacent and not sampled (-)"
+    if comparison is not None:
+        columns.append("srdf")
+        rows = [[*row, comparison.marks.get(frozenset(row[:2]), "")] for row in rows]
+        caption += f"; srdf: why {comparison.path.name} disables the pair (empty: MoveIt checks it)"
+    table = Table(title=title, columns=columns, rows=rows, caption=caption,
                   numeric_columns=("collisions", "fraction", "limit hits"))
     summary = ", ".join(f"{counts[c]} {c}" for c in cm.CATEGORIES)
     rate = run.configs_per_second
@@ -43,8 +57,55 @@ def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str) -> Repo
         f"{rate:,.0f} configurations/s with {_count(run.jobs, 'job')}" if rate else "",
     ]
     lines += [f"{w.severity.value}: {w.message}" + (f" ({w.hint})" if w.hint else "") for w in run.warnings]
-    return Report(data=data, tables=[table], renderables=[cm.heat_map(run.links, run.pairs, run.results)],
+    tables = [table]
+    if comparison is not None:
+        if comparison.rows:
+            tables.append(compare_table(comparison, run.samples))
+        lines.append(compare_summary(comparison))
+    if merged is not None:
+        lines.append(f"merged into {merged.target}: {_count(merged.removed, 'generated pair')} of {merged.source.name} "
+                     f"replaced by {merged.written}; {merged.kept} hand-written collision entries kept")
+    return Report(data=data, tables=tables, renderables=[cm.heat_map(run.links, run.pairs, run.results)],
                   lines=[line for line in lines if line])
+
+
+COMPARE_MEANING = {
+    "dangerous": "disabled, but collides: MoveIt would plan through this contact",
+    "missing": "enabled, but MoveIt disables it (adjacent, touching at home or almost always)",
+    "wasted": "enabled, never collided: a check that never fires",
+    "unknown": "names a link the URDF does not have",
+}
+
+
+def compare_table(comparison: Comparison, samples: int) -> Table:
+    """The disagreements between the existing SRDF and the sampled matrix, worst first."""
+    rows = []
+    for row in comparison.rows:
+        found = row.result
+        if found is None:
+            rows.append([row.status, row.link_a, row.link_b, row.srdf, "", "", "", "", row.line or ""])
+            continue
+        collisions = found.collisions if found.sampled else "-"
+        fraction = f"{found.fraction:.4f}" if found.sampled else "-"
+        rows.append([row.status, row.link_a, row.link_b, row.srdf, found.category, collisions, fraction,
+                     len(found.limit_hits) or "", row.line or ""])
+    caption = "; ".join(f"{status}: {meaning}" for status, meaning in COMPARE_MEANING.items())
+    return Table(title=f"{comparison.path.name} against the sampled matrix ({samples} samples)",
+                 columns=["status", "link a", "link b", "srdf", "category", "collisions", "fraction", "limit hits",
+                          "srdf line"],
+                 rows=rows, caption=caption, status_column="status",
+                 numeric_columns=("collisions", "fraction", "limit hits", "srdf line"))
+
+
+def compare_summary(comparison: Comparison) -> str:
+    counts = ", ".join(f"{comparison.count(status)} {status}" for status in STATUSES)
+    text = (f"{comparison.path.name}: {_count(comparison.disabled, 'disabled pair')} ({comparison.generated} "
+            f"generated, {comparison.hand_written} hand-written); {counts}")
+    if not comparison.rows:
+        text += " (the SRDF and the sampled matrix agree)"
+    if comparison.unsampled:
+        text += f"; {comparison.unsampled} entries name links without collision geometry (nothing to check)"
+    return text
 
 
 def _ordered(results: list[cm.PairResult]) -> list[cm.PairResult]:
