@@ -13,6 +13,8 @@ import typer
 from ar3cli import __version__
 from ar3cli.commands.fix_continuous import fix_continuous
 from ar3cli.commands.fix_inertia import fix_inertia
+from ar3cli.commands.fix_joints import fix_joints
+from ar3cli.commands.fix_mesh_paths import fix_mesh_paths
 from ar3cli.commands.fk_verify import fk_verify
 from ar3cli.commands.grasp_demo import grasp_demo
 from ar3cli.commands.info import info
@@ -55,6 +57,8 @@ app.command("lint-urdf")(lint_urdf)
 app.command("grasp-demo")(grasp_demo)
 app.command("fix-inertia")(fix_inertia)
 app.command("fix-continuous")(fix_continuous)
+app.command("fix-joints")(fix_joints)
+app.command("fix-mesh-paths")(fix_mesh_paths)
 app.command("sample-collisions")(sample_collisions)
 
 

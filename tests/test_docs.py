@@ -13,7 +13,8 @@ from tests.conftest import REPO
 
 DOC_FILES = sorted([REPO / "README.md", *(REPO / "docs").rglob("*.md")])
 CODE = re.compile(r"```[^\n]*\n(.*?)```|`([^`\n]+)`", re.DOTALL)
-INVOCATION = re.compile(r"(?<![\w/.-])ar3cli ([a-z][a-z-]+)([^\n`|]*)")
+INVOCATION = re.compile(r"(?<![\w/.-])ar3cli ([a-z][a-z-]+)(?![\w:-])([^\n`|]*)")
+"""``ar3cli COMMAND ...``; not ``ar3cli sample-collisions:`` (the marker comment a merged SRDF carries)."""
 
 
 def _commands() -> dict:

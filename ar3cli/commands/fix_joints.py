@@ -1,0 +1,50 @@
+"""``ar3cli fix-joints``: swap inverted limits, degrees to radians, unit axes, missing effort/velocity."""
+
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.output.report import OutputFormat
+
+
+def fix_joints(
+    paths: FixPathsArgument,
+    effort: Annotated[Optional[float], typer.Option(
+        "--effort", help="Effort (N*m or N) to add where a `<limit>` has none (J007).")] = None,
+    velocity: Annotated[Optional[float], typer.Option(
+        "--velocity", help="Velocity (rad/s or m/s) to add where a `<limit>` has none (J007).")] = None,
+    limits_from: Annotated[Optional[Path], typer.Option(
+        "--limits-from", metavar="JOINT_LIMITS_YAML",
+        help="MoveIt joint_limits.yaml: its max_effort / max_velocity fill a `<limit>` without them "
+             "(before --effort / --velocity).")] = None,
+    verify: Annotated[bool, typer.Option(
+        "--verify/--no-verify", help="After writing, load the result in PyBullet and read the joints back.")] = True,
+    diff: DiffOption = False,
+    check: CheckOption = False,
+    output: OutputOption = None,
+    package_path: PackagePathOption = None,
+    format: FormatOption = OutputFormat.text,
+) -> None:
+    """Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
+
+    Inverted limits (J003) are swapped; revolute limits in degrees (J005) become radians; a
+    non-unit axis (J010) is normalised; a `<limit>` without effort or velocity (J007) gets them
+    from --limits-from or --effort/--velocity. A zero axis (J009) cannot be fixed automatically:
+    it is reported, with what to do. Only the changed attributes are edited.
+    """
+    from ar3cli.errors import UserError
+    from ar3cli.fix.continuous_plan import read_joint_limits
+    from ar3cli.fix.driver import run_fixer
+    from ar3cli.fix.joints_plan import JointsOptions, make_fixer
+    from ar3cli.fix.joints_plan import verify as verify_in_pybullet
+
+    for name, value in (("--effort", effort), ("--velocity", velocity)):
+        if value is not None and not value > 0:
+            raise UserError(f"{name} {value}: must be positive")
+    limits = read_joint_limits(limits_from) if limits_from is not None else None
+    options = JointsOptions(effort, velocity, limits, limits_from)
+    code = run_fixer("fix-joints", paths, make_fixer(options), diff=diff, check=check, output=output,
+                     fmt=format, package_path=package_path, verifier=verify_in_pybullet if verify else None)
+    raise typer.Exit(code)

@@ -1,0 +1,232 @@
+"""The fix-joints fixer: the joint findings of lint-urdf that have one right answer.
+
+What it fixes is decided by the lint rules themselves, run on the model at call time (so a change
+to a rule's heuristic changes the fixer with it):
+
+* J003 (lower > upper on a revolute or prismatic joint): ``lower`` and ``upper`` swapped, each
+  keeping the other's text byte for byte;
+* J005 (revolute limits that look like degrees): ``lower`` and ``upper`` converted to radians,
+  both of them, as the rule's hint does (a person who typed one limit in degrees typed both);
+* J009 (zero axis): not fixable, there is no direction to recover: reported as not fixed;
+* J010 (axis not a unit vector): normalised, written with :func:`~ar3cli.fix.driver.number`;
+* J007 (``<limit>`` without effort or velocity): filled from MoveIt's ``joint_limits.yaml``
+  (``--limits-from``, its max_effort / max_velocity when has_*_limits is true), else from
+  ``--effort`` / ``--velocity``; when neither says, the joint is reported as not fixed.
+
+:func:`verify` loads the written file in PyBullet and reads each changed joint back.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+from ar3cli.errors import UserError
+from ar3cli.fix.continuous_plan import YamlLimits
+from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
+from ar3cli.fix.edits import Document
+
+INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
+"""The lint rules whose findings fix-joints acts on."""
+SAME_NUMBER = 1e-12
+"""Relative tolerance under which a computed value is the file's (and nothing is rewritten)."""
+
+
+@dataclass
+class JointsOptions:
+    effort: float | None = None
+    velocity: float | None = None
+    limits: dict[str, YamlLimits] | None = None
+    limits_path: Path | None = None
+
+
+def make_fixer(options: JointsOptions):
+    def fix(model, document: Document) -> FixPlan:
+        return plan_joints(model, document, options)
+
+    return fix
+
+
+def flagged_joints(model, code: str) -> set[str]:
+    """The joints (their element paths, ``/robot/joint[3]``: names may repeat) the lint rule
+    ``code`` reports on ``model``, by running the rule's own check, imported at call time: the rule
+    is the one definition of what it flags."""
+    from ar3cli.lint.context import Context
+    from ar3cli.lint.rules import joints as joint_rules
+    from ar3cli.lint.rules.base import Rule
+
+    rules = [value for value in vars(joint_rules).values() if isinstance(value, Rule) and value.code == code]
+    if not rules or rules[0].check is None:
+        raise UserError(f"internal: lint rule {code} not found in ar3cli.lint.rules.joints")
+    names: set[str] = set()
+    for hit in rules[0].check(Context(model)):
+        element = hit.element
+        while element is not None and element.tag != "joint":
+            element = element.getparent()
+        if element is not None:
+            names.add(_path(element))
+    return names
+
+
+def _path(element) -> str:
+    return element.getroottree().getpath(element)
+
+
+def plan_joints(model, document: Document, options: JointsOptions) -> FixPlan:
+    plan = FixPlan(context={"joints": {}})
+    for name in options.limits or {}:
+        if model.joint(name) is None:
+            plan.notes.append(f"warning: {options.limits_path}: joint {name!r} is not in {model.path}")
+    flagged = {code: flagged_joints(model, code)
+               for code in (INVERTED, DEGREES, AXIS_ZERO, AXIS_NOT_UNIT, EFFORT_VELOCITY_MISSING)}
+    swapped: list[str] = []
+    for joint in model.joints:
+        path = _path(joint.element)
+        if path in flagged[INVERTED] or path in flagged[DEGREES]:
+            _fix_range(document, plan, joint, swap=path in flagged[INVERTED], degrees=path in flagged[DEGREES])
+        if path in flagged[INVERTED]:
+            swapped.append(joint.name)
+        if path in flagged[AXIS_ZERO]:
+            axis = joint.element.find("axis")
+            plan.skipped.append(Skipped(
+                _element(joint), (axis.sourceline if axis is not None else None) or joint.line,
+                f"axis is {axis.get('xyz') if axis is not None else '0 0 0'}: no direction to normalise; "
+                "set the joint's real axis by hand (a unit vector in the joint frame, e.g. <axis xyz=\"0 0 1\"/>)"))
+        elif path in flagged[AXIS_NOT_UNIT]:
+            _normalise_axis(document, plan, joint)
+        if path in flagged[EFFORT_VELOCITY_MISSING]:
+            _fill_effort_velocity(document, plan, joint, options)
+    if swapped:
+        plan.notes.append(f"note: {model.path}: PyBullet reads lower > upper as 'no limit'; the swapped joint(s) "
+                          f"{', '.join(swapped)} are limited to [lower, upper] there now. If the file meant unlimited "
+                          "(pybullet_data's lower=\"1\" upper=\"-1\" idiom), give the real travel instead, or make "
+                          "a revolute joint continuous")
+    return plan
+
+
+def _element(joint) -> str:
+    return f"joint {joint.name}"
+
+
+def _record(plan: FixPlan, joint, **values) -> None:
+    plan.context["joints"].setdefault(joint.name, {}).update(values)
+
+
+def _fix_range(document: Document, plan: FixPlan, joint, *, swap: bool, degrees: bool) -> None:
+    """Swap (J003) and/or convert to radians (J005) the joint's lower/upper."""
+    limit = joint.limit
+    texts = {key: limit.element.get(key) for key in ("lower", "upper")}
+    values = {"lower": limit.lower, "upper": limit.upper}
+    reasons = []
+    if swap:
+        texts = {"lower": texts["upper"], "upper": texts["lower"]}
+        values = {"lower": values["upper"], "upper": values["lower"]}
+        reasons.append(f"{INVERTED}: lower > upper, swapped")
+    if degrees:
+        for key in ("lower", "upper"):
+            if values[key] is not None and math.isfinite(values[key]):
+                values[key] = math.radians(values[key])
+                texts[key] = number(values[key])
+        reasons.append(f"{DEGREES}: degrees, converted to radians (x pi/180)")
+    span = document.span(limit.element)
+    line = limit.element.sourceline or joint.line
+    for key in ("lower", "upper"):
+        old, new = limit.element.get(key), texts[key]
+        if new is None or old == new or (not swap and same_numbers(old, new, rel_tol=SAME_NUMBER)):
+            continue
+        document.set_attribute(span, key, new)
+        plan.changes.append(Change(_element(joint), line, f"limit {key}", old, new, "; ".join(reasons)))
+    _record(plan, joint, lower=values["lower"], upper=values["upper"])
+
+
+def _normalise_axis(document: Document, plan: FixPlan, joint) -> None:
+    axis = joint.element.find("axis")
+    norm = math.sqrt(sum(c * c for c in joint.axis))
+    unit = tuple(c / norm for c in joint.axis)
+    new = " ".join(number(c) for c in unit)
+    old = axis.get("xyz")
+    if old == new:
+        return
+    document.set_attribute(document.span(axis), "xyz", new)
+    plan.changes.append(Change(_element(joint), axis.sourceline or joint.line, "axis xyz", old, new,
+                               f"{AXIS_NOT_UNIT}: length {norm:.6g}, normalised"))
+    _record(plan, joint, axis=unit)
+
+
+def _fill_effort_velocity(document: Document, plan: FixPlan, joint, options: JointsOptions) -> None:
+    """Add the missing effort/velocity of a <limit>: from the yaml, else from the options."""
+    limit = joint.limit
+    entry = (options.limits or {}).get(joint.name)
+    source = options.limits_path.name if options.limits_path else "joint_limits.yaml"
+    line = limit.element.sourceline or joint.line
+    span = document.span(limit.element)
+    for key in ("effort", "velocity"):
+        if limit.element.get(key) is not None:
+            continue
+        from_yaml = getattr(entry, key) if entry is not None else None
+        option = options.effort if key == "effort" else options.velocity
+        if from_yaml is not None:
+            value, origin = from_yaml, f"{source}: max_{key}"
+        elif option is not None:
+            value, origin = option, f"--{key}"
+        else:
+            where = f" and {source} has no max_{key} for it" if options.limits is not None else ""
+            plan.skipped.append(Skipped(_element(joint), line,
+                                        f"<limit> has no {key}{where}: pass --{key} or --limits-from "
+                                        "joint_limits.yaml (urdfdom refuses a <limit> without it)"))
+            continue
+        text = number(value)
+        document.set_attribute(span, key, text)
+        plan.changes.append(Change(_element(joint), line, f"limit {key}", None, text, f"{origin} (added)"))
+        _record(plan, joint, **{key: float(text)})
+
+
+# ---- verification in PyBullet -----------------------------------------------------------------
+def verify(model, plan: FixPlan) -> dict:
+    """Load the fixed file in PyBullet; each changed joint's limits, effort, velocity and axis as
+    getJointInfo reports them must be the new values."""
+    from ar3cli.sim.session import run_pybullet
+
+    joints = plan.context.get("joints", {})
+    if not joints:
+        return {"verified": True, "checks": []}
+    try:
+        checks = run_pybullet(lambda: _checks_in_pybullet(model, joints), model)
+    except UserError as exc:  # shown as a row too: the text output renders the checks only
+        message = exc.message.removeprefix(f"{model.path}: ")  # the path of the temporary file
+        return {"verified": False, "checks": [_check("(the file)", "loaded", False, message)], "error": message}
+    return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+
+
+def _checks_in_pybullet(model, joints: dict) -> list[dict]:
+    from ar3cli.sim.session import Session
+
+    checks: list[dict] = []
+    with Session() as session:
+        body = session.load(model, visuals=False, allow_nan_frames=True)  # a zero axis left alone is NaN
+        records = {record.name: record for record in body.joints}
+        for name, expected in joints.items():
+            record = records.get(name)
+            if record is None:
+                checks.append(_check(name, "loaded", False, "joint not found in pybullet"))
+                continue
+            info = session.p.getJointInfo(body.id, record.index, physicsClientId=session.client)
+            if "lower" in expected:
+                ok = all(value is None or math.isclose(got, value, rel_tol=1e-9, abs_tol=1e-9)
+                         for got, value in ((info[8], expected["lower"]), (info[9], expected["upper"])))
+                checks.append(_check(name, "limits", ok, f"getJointInfo lower={info[8]:.9g} upper={info[9]:.9g}"))
+            for key, index in (("effort", 10), ("velocity", 11)):
+                if key in expected:
+                    checks.append(_check(name, key, math.isclose(info[index], expected[key], rel_tol=1e-9),
+                                         f"getJointInfo {key}={info[index]:.9g}"))
+            if "axis" in expected:
+                got = info[13]
+                ok = all(math.isclose(a, b, abs_tol=1e-9) for a, b in zip(got, expected["axis"]))
+                checks.append(_check(name, "unit axis", ok,
+                                     "getJointInfo axis=" + " ".join(f"{c:.9g}" for c in got)))
+    return checks
+
+
+def _check(joint: str, check: str, ok: bool, detail: str) -> dict:
+    return {"joint": joint, "check": check, "status": "ok" if ok else "fail", "detail": detail}
