@@ -230,3 +230,14 @@ def test_atomic_write_respects_a_read_only_file(tmp_path):
     with pytest.raises(UserError, match="is read-only"):
         atomic_write(target, b"new")
     assert target.read_bytes() == b"old" and not stale_temps(tmp_path)
+
+
+def test_diff_of_a_long_file_shows_only_the_changed_lines(tmp_path):
+    """difflib's autojunk made frequent lines (</geometry>) look removed and added again past 200 lines."""
+    from ar3cli.fix.driver import unified_diff
+
+    old = "".join(f"<geometry>{i}</geometry>\n</geometry>\n" for i in range(300))
+    new = old.replace("<geometry>150</geometry>", "<geometry>changed</geometry>")
+    diff = unified_diff(tmp_path / "x.urdf", old.encode(), new.encode())
+    assert [line for line in diff.splitlines() if line.startswith(("-", "+")) and not line.startswith(("---", "+++"))] \
+        == ["-<geometry>150</geometry>", "+<geometry>changed</geometry>"]

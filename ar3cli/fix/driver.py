@@ -172,12 +172,32 @@ def _check_parses(path: Path, data: bytes) -> None:
     xmlsource.parse(normalized, path)  # raises UserError (a fixer bug) rather than writing junk
 
 
-def unified_diff(path: Path, old: bytes, new: bytes) -> str:
+def unified_diff(path: Path, old: bytes, new: bytes, context: int = 3) -> str:
+    """A unified diff like ``difflib.unified_diff``, matched without its "autojunk" heuristic: in a
+    file over 200 lines difflib treats frequent lines (``</geometry>``) as junk and shows them as
+    removed and added again, so a diff of 16 changes listed 41 removed lines (measured on kuka_iiwa)."""
     from ar3cli.urdf.xmlsource import decode_text
 
-    return "".join(difflib.unified_diff(decode_text(old).splitlines(keepends=True),
-                                        decode_text(new).splitlines(keepends=True),
-                                        fromfile=_diff_name("a", path), tofile=_diff_name("b", path)))
+    a, b = decode_text(old).splitlines(keepends=True), decode_text(new).splitlines(keepends=True)
+    lines = [f"--- {_diff_name('a', path)}\n", f"+++ {_diff_name('b', path)}\n"]
+    for group in difflib.SequenceMatcher(None, a, b, autojunk=False).get_grouped_opcodes(context):
+        first, last = group[0], group[-1]
+        lines.append(f"@@ -{_hunk_range(first[1], last[2])} +{_hunk_range(first[3], last[4])} @@\n")
+        for tag, i1, i2, j1, j2 in group:
+            if tag == "equal":
+                lines += [" " + line for line in a[i1:i2]]
+                continue
+            lines += ["-" + line for line in a[i1:i2]]
+            lines += ["+" + line for line in b[j1:j2]]
+    return "".join(lines) if len(lines) > 2 else ""
+
+
+def _hunk_range(start: int, stop: int) -> str:
+    """``start,length`` of a hunk, 1-based, as unified diffs write it (``start`` alone for one line)."""
+    length = stop - start
+    if length == 1:
+        return str(start + 1)
+    return f"{start + 1 if length else start},{length}"
 
 
 def _diff_name(side: str, path: Path) -> str:
