@@ -102,14 +102,16 @@ def _split(items: list[str] | None) -> list[str]:
     return [part for item in items or [] for part in item.split(",")]
 
 
-def summary_line(summary: dict) -> str:
+def summary_line(summary: dict, cached: int = 0) -> str:
+    """The verdict line; ``cached`` files answered from the result cache are said when there are any."""
     files = summary["files"]
     broken = summary["files_with_errors"]
     clean = summary["files_clean"]
     verdict = "FAILED" if summary["failed"] or broken else "passed"
     unchecked = f"; {broken} not fully checked (pybullet crashed)" if broken else ""
+    remembered = f"; {cached} unchanged since an earlier run (from the cache)" if cached else ""
     return (f"{verdict}: {files} file{'s' if files != 1 else ''} checked, {summary['error']} errors, "
-            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{unchecked} "
+            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{unchecked}{remembered} "
             f"(fail-on: {summary['fail_on']})")
 
 
@@ -137,7 +139,7 @@ def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool 
     tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
                     rows=_rows(result.findings, grouped), status_column="severity", nowrap_columns=("location",))
               for result in results if result.findings]
-    return Report(data=data, tables=tables, lines=[summary_line(summary)], ok=ok)
+    return Report(data=data, tables=tables, lines=[summary_line(summary, sum(r.cached for r in results))], ok=ok)
 
 
 def _rows(findings, grouped: bool) -> list[list]:

@@ -61,6 +61,8 @@ class LintResult:
     loaded: bool
     findings: list[Finding]
     error: str | None = None
+    cached: bool = False
+    """Answered from the result cache (said in the text summary; the JSON is the same either way)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
@@ -163,7 +165,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     if cache is not None and not is_xacro(path):
         remembered = cache.get(path, shown)
         if remembered is not None:
-            return LintResult(shown, True, remembered)
+            return LintResult(shown, True, remembered, cached=True)
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
