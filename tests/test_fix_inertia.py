@@ -420,3 +420,17 @@ def test_implausible_links_by_hand_and_option_conflicts(cli, write_urdf):
         result = cli("fix-inertia", str(path), "--include-implausible", *other)
         assert result.code == 2 and "--include-implausible widens the default selection" in result.stderr
     assert path.read_text() == PLACEHOLDER
+
+
+def test_the_fixer_says_what_lint_still_finds_after_the_fix(cli, tmp_path):
+    """Issue 17: after a fix the result is linted again (from the new bytes, nothing extra written)."""
+    import shutil
+
+    path = tmp_path / "arm.urdf"
+    shutil.copy(ASSETS / "examples" / "ar3_no_inertia.urdf", path)
+    result = cli("fix-inertia", str(path), "--density", "1200", "--check", "--format", "json")
+    (entry,) = json.loads(result.stdout)["files"]
+    assert entry["remaining"]["error"] == 0 and "I001" not in entry["remaining"]["rules"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.urdf"]
+    text = cli("fix-inertia", str(path), "--density", "1200", "--diff")
+    assert "after the fix, ar3cli lint-urdf" in text.stderr + text.stdout

@@ -205,16 +205,16 @@ def test_a_dependency_that_changes_during_the_check_makes_the_entry_stale(store,
 
     path = write_urdf(MESH_ROBOT.format(uri="meshes/part.stl"))
     write_stl(tmp_path / "meshes" / "part.stl", 0.1)
-    real = engine._lint_model
+    real = engine.lint_model
 
     def lint_then_delete(*args, **kwargs):
         result = real(*args, **kwargs)
         (tmp_path / "meshes" / "part.stl").unlink()  # e.g. a git checkout while the hook runs
         return result
 
-    monkeypatch.setattr(engine, "_lint_model", lint_then_delete)
+    monkeypatch.setattr(engine, "lint_model", lint_then_delete)
     assert "G001" not in codes(path)
-    monkeypatch.setattr(engine, "_lint_model", real)
+    monkeypatch.setattr(engine, "lint_model", real)
     assert "G001" in codes(path)
     assert len(loads) == 2
 

@@ -69,6 +69,8 @@ class FixResult:
     written: Path | None = None
     diff: str = ""
     verification: dict[str, Any] | None = None
+    remaining: dict[str, Any] | None = None
+    """What a static lint of the result still finds: counts per severity and the rule codes."""
 
     def to_dict(self) -> dict[str, Any]:
         data = {"path": str(self.path), "changed": self.changed,
@@ -78,6 +80,8 @@ class FixResult:
                 **self.plan.data}
         if self.verification is not None:
             data["verification"] = self.verification
+        if self.remaining is not None:
+            data["remaining"] = self.remaining
         if self.diff:
             data["diff"] = self.diff
         return data
@@ -147,6 +151,8 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
             _check_parses(path, new)
         if diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
+        if result.changed:
+            result.remaining = remaining_findings(path, new, package_path)
         planned.append((result, new))
     if not diff and not check:
         for result, _ in planned:
@@ -165,11 +171,31 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     return _report(command, [result for result, _ in planned], diff=diff, check=check, fmt=fmt)
 
 
+def remaining_findings(path: Path, data: bytes, package_path: list[str] | None) -> dict[str, Any]:
+    """A static lint of the fixed bytes (nothing is written for it): what is left to do."""
+    from ar3cli.lint.engine import LintOptions, lint_model
+    from ar3cli.urdf.model import load_model
+    from ar3cli.urdf.packages import parse_package_paths
+
+    options = LintOptions(package_paths=parse_package_paths(package_path))
+    findings = lint_model(load_model(path, options.package_paths, source=data), str(path), options.rules(), options).findings
+    counts = {severity: sum(f.severity.value == severity for f in findings) for severity in ("error", "warning", "info")}
+    return {**counts, "rules": sorted({f.rule for f in findings})}
+
+
 def _check_parses(path: Path, data: bytes) -> None:
     from ar3cli.urdf import xmlsource
 
     normalized, _ = xmlsource.normalize(data)
     xmlsource.parse(normalized, path)  # raises UserError (a fixer bug) rather than writing junk
+
+
+def _remaining_line(result: FixResult) -> str:
+    left = result.remaining or {}
+    if not left.get("rules"):
+        return f"{result.path}: after the fix, ar3cli lint-urdf finds nothing"
+    return (f"{result.path}: after the fix, ar3cli lint-urdf still finds {left['error']} error(s), "
+            f"{left['warning']} warning(s), {left['info']} info ({', '.join(left['rules'])}); run it for details")
 
 
 def unified_diff(path: Path, old: bytes, new: bytes, context: int = 3) -> str:
@@ -242,6 +268,8 @@ def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, 
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) changed, written to {r.written}")
         else:
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) would change")
+        if r.remaining is not None:
+            lines.append(_remaining_line(r))
     patch = "".join(r.diff for r in results) if diff else ""
     render_report(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK, text=patch), fmt)
     return code

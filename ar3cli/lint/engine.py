@@ -173,7 +173,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     except RecursionError:
         finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
     else:
-        result = _lint_model(model, shown, rules, options)
+        result = lint_model(model, shown, rules, options)
         if cache is not None and not model.is_xacro:
             cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
         return result
@@ -184,7 +184,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     return LintResult(shown, False, [_override(finding, options)])
 
 
-def _lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
+def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
     """Run ``rules`` on a loaded model and apply suppressions and severity overrides.
 
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when

@@ -262,10 +262,15 @@ def load_model(
     path: str | Path,
     package_paths: Mapping[str, Path] | None = None,
     xacro_args: Mapping[str, str] | None = None,
+    source: bytes | None = None,
 ) -> Model:
-    """Read, expand (xacro), parse and index one robot file; bad input raises :class:`UserError`."""
+    """Read, expand (xacro), parse and index one robot file; bad input raises :class:`UserError`.
+
+    ``source`` stands in for the file's bytes (a fixer's result, checked before anything is
+    written); ``path`` still says where relative mesh paths start.
+    """
     path = Path(path)
-    source = read_bytes(path)
+    source = read_bytes(path) if source is None else source
     if not source.strip(b"\x00 \t\r\n"):
         raise UserError(f"{path}: file is empty")
     resolver = PackageResolver(path.parent, package_paths)
