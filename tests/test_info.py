@@ -224,3 +224,62 @@ def test_box_prefers_geometry_that_needs_no_trimesh(write_urdf):
     model = load_model(path)
     assert [[shape.role for shape in box_shapes(link)] for link in model.links] == \
         [["collision"], ["visual"], ["collision"]]
+
+
+def _ink(image, box=None) -> int:
+    """Pixels that are not white (in ``box`` when given)."""
+    region = image.convert("L") if box is None else image.convert("L").crop(box)
+    return sum(count for count, value in region.getcolors(1 << 16) if value < 250)
+
+
+def test_png_of_the_tree(cli, tmp_path, pybullet_data_dir):
+    """The picture exists, grows with the tree (a chain is tall and narrow, the TIAGo-like hand wide),
+    and is not blank."""
+    from PIL import Image
+
+    sizes = {}
+    for name, path in [("ar3", AR3), ("panda", pybullet_data_dir / "franka_panda" / "panda.urdf")]:
+        out = tmp_path / f"{name}.png"
+        result = cli("info", str(path), "--png", str(out), "--format", "json")
+        assert result.code == 0, result.stderr
+        assert json.loads(result.stdout)["png"] == str(out)
+        image = Image.open(out)
+        assert image.format == "PNG"
+        sizes[name] = image.size
+        assert _ink(image) > 2000  # boxes, labels and edges were drawn
+        assert _ink(image, (0, image.height // 2, image.width, image.height)) > 500  # the lower half too
+    # The AR3: 9 levels, 3 leaves side by side; the panda: 12 levels (fingers under the hand).
+    assert sizes["ar3"][1] > sizes["ar3"][0] and sizes["panda"][1] > sizes["ar3"][1]
+    assert 200 < sizes["ar3"][0] < 600 and 600 < sizes["ar3"][1] < 1200
+
+
+def test_png_of_a_wide_tree_and_a_loop(tmp_path, write_urdf):
+    """60 siblings side by side: the canvas widens so no two labels overlap; a loop joint is listed."""
+    from PIL import Image
+
+    from ar3cli.info.summary import summarize
+    from ar3cli.info.tree_png import tree_png
+    from ar3cli.urdf.model import load_model
+
+    links = "".join(f'<link name="leaf_{i}"/>' for i in range(60))
+    joints = "".join(f'<joint name="j{i}" type="revolute"><parent link="hub"/><child link="leaf_{i}"/>'
+                     '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>' for i in range(60))
+    wide = write_urdf(f'<robot name="w"><link name="hub"/>{links}{joints}</robot>')
+    data = tree_png(summarize(load_model(wide), lambda model: {}))
+    (tmp_path / "wide.png").write_bytes(data)
+    image = Image.open(tmp_path / "wide.png")
+    assert image.width > 60 * 50 and image.height < 300
+    loop = write_urdf("""<robot name="loop"><link name="r"/><link name="p"/><link name="q"/>
+      <joint name="a" type="fixed"><parent link="r"/><child link="p"/></joint>
+      <joint name="b" type="continuous"><parent link="p"/><child link="q"/></joint>
+      <joint name="c" type="continuous"><parent link="q"/><child link="p"/></joint></robot>""", "loop.urdf")
+    assert tree_png(summarize(load_model(loop), lambda model: {}))[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_png_refused_before_any_work(cli, tmp_path):
+    for bad, message in [(tmp_path / "tree.jpg", "--png"), (tmp_path / "nodir" / "tree.png", "does not exist")]:
+        result = cli("info", str(tmp_path / "missing.urdf"), "--png", str(bad))
+        assert result.code == 2 and result.stdout == "", result.stderr
+        (line,) = result.stderr.strip().splitlines()
+        assert message in line and "missing.urdf" not in line  # refused before the robot is read
+    assert "must end in .png" in cli("info", str(AR3), "--png", str(tmp_path / "t.jpg")).stderr

@@ -1,19 +1,26 @@
 """The self-collision pair matrix as a picture (PNG), for READMEs, reviews and CI artifacts.
 
-Lower triangle, one cell per pair of links with collision geometry. Colour says the category
-(MoveIt's): adjacent grey-blue, default red, always magenta, never pale green, sometimes a yellow to
-orange ramp by the colliding fraction (its percentage is written in the cell). The same data as
-the terminal heat map (:func:`ar3cli.collisions.matrix.heat_map`), drawn with Pillow.
+Lower triangle, one cell per pair of links with collision geometry, the link names on both axes
+(rows on the left, columns underneath). Each of MoveIt's categories has its colour and, but for
+``never``, the letter the terminal heat map uses (:func:`ar3cli.collisions.matrix.heat_map`), so the
+categories stay apart in greyscale too: adjacent grey-blue ``A``, default red ``D`` (in contact at
+home), always magenta ``X``, never pale green (empty). A ``sometimes`` cell is coloured on a
+logarithmic yellow-orange-brown scale by the fraction of samples in collision (0.1% and below the
+palest, 100% the darkest) and holds the count of colliding samples when it fits in the cell; a pair
+that touched only at a joint limit (no sample) is pale yellow with ``L``. Under the matrix, the
+legend: one swatch per category and the colour scale with its numbers. Drawn with Pillow.
 """
 
 from __future__ import annotations
 
 import io
+import math
 from collections.abc import Sequence
+from typing import Any
 
 from ar3cli.collisions.matrix import PairResult
 
-CELL = 34
+CELL = 36
 MARGIN = 12
 CATEGORY_COLOURS = {
     "adjacent": (120, 144, 180),
@@ -21,35 +28,83 @@ CATEGORY_COLOURS = {
     "always": (170, 60, 170),
     "never": (214, 240, 214),
 }
-SOMETIMES_LOW, SOMETIMES_HIGH = (255, 236, 140), (240, 120, 20)
-LEGEND = [("adjacent", CATEGORY_COLOURS["adjacent"]), ("default (at home)", CATEGORY_COLOURS["default"]),
-          ("always", CATEGORY_COLOURS["always"]), ("never", CATEGORY_COLOURS["never"]),
-          ("sometimes (% of samples)", SOMETIMES_HIGH)]
+CATEGORY_LETTERS = {"adjacent": "A", "default": "D", "always": "X", "never": ""}
+LIMIT_ONLY = "L"
+RAMP = ((255, 240, 160), (245, 150, 40), (140, 45, 15))
+"""The 'sometimes' scale: pale yellow at SCALE_LOW and below, orange half-way (log), brown at 100%."""
+SCALE_LOW = 0.001
+"""The fraction at the pale end of the scale: most 'sometimes' pairs collide in 0.1% to 10% of samples."""
+SCALE_TICKS = (0.001, 0.01, 0.1, 1.0)
+BAR_WIDTH = 240
+BAR_HEIGHT = 14
+LEGEND = [("adjacent", "adjacent (joined by a joint)"), ("default", "default (in contact at home)"),
+          ("always", "always (in contact in nearly every sample)"), ("never", "never (no contact seen)")]
+
+
+def scale_position(fraction: float) -> float:
+    """0..1 along the colour scale: log10 from :data:`SCALE_LOW` (0) to 1.0 (1), clipped."""
+    if fraction <= SCALE_LOW:
+        return 0.0
+    return min(1.0, math.log10(fraction / SCALE_LOW) / -math.log10(SCALE_LOW))
+
+
+def ramp_colour(t: float) -> tuple[int, int, int]:
+    """The colour at position ``t`` (0..1) of :data:`RAMP`."""
+    t = min(1.0, max(0.0, t))
+    segment = min(int(t * (len(RAMP) - 1)), len(RAMP) - 2)
+    local = t * (len(RAMP) - 1) - segment
+    low, high = RAMP[segment], RAMP[segment + 1]
+    return tuple(round(a + (b - a) * local) for a, b in zip(low, high))  # type: ignore[return-value]
 
 
 def cell_colour(result: PairResult) -> tuple[int, int, int]:
-    """The fill of one pair's cell: its category's colour, or a ramp by fraction for 'sometimes'."""
+    """The fill of one pair's cell: its category's colour, or the scale colour of its fraction for 'sometimes'."""
     if result.category != "sometimes":
         return CATEGORY_COLOURS[result.category]
-    t = min(1.0, result.fraction * 2.0)  # most 'sometimes' pairs collide rarely; saturate at 50%
-    return tuple(round(lo + (hi - lo) * t) for lo, hi in zip(SOMETIMES_LOW, SOMETIMES_HIGH))  # type: ignore[return-value]
+    return ramp_colour(scale_position(result.fraction))
+
+
+def cell_text(result: PairResult) -> str:
+    """What a cell says: the category letter, the count of colliding samples, or L (limits only)."""
+    if result.category != "sometimes":
+        return CATEGORY_LETTERS[result.category]
+    return str(result.collisions) if result.collisions else LIMIT_ONLY
 
 
 def heat_map_png(links: Sequence[str], pairs: Sequence[tuple[int, int]], results: Sequence[PairResult],
                  title: str = "") -> bytes:
-    """PNG bytes of the lower-triangular link x link matrix."""
+    """PNG bytes of the lower-triangular link x link matrix with its legend."""
+    image, _ = heat_map_image(links, pairs, results, title)
+    buffer = io.BytesIO()
+    image.save(buffer, format="PNG")
+    return buffer.getvalue()
+
+
+def heat_map_image(links: Sequence[str], pairs: Sequence[tuple[int, int]], results: Sequence[PairResult],
+                   title: str = "") -> tuple[Any, dict[str, tuple[int, int, int, int]]]:
+    """The Pillow image and where its parts are: ``{"grid", "legend", "scale"}`` boxes (left, top,
+    right, bottom), for tests."""
     from PIL import Image, ImageDraw, ImageFont
 
     font = _font(ImageFont, 13)
-    small = _font(ImageFont, 10)
+    small = _font(ImageFont, 11)
     cell = {pair: result for pair, result in zip(pairs, results)}
     probe = ImageDraw.Draw(Image.new("RGB", (1, 1)))
     label_width = max((probe.textlength(name, font=font) for name in links), default=0) + 10
     top = MARGIN + (24 if title else 0)
-    grid = CELL * max(len(links) - 1, 1)
-    width = int(MARGIN + label_width + grid + MARGIN)
-    height = int(top + grid + 10 + label_width + 20 * len(LEGEND) + MARGIN)
-    image = Image.new("RGB", (max(width, 340), height), "white")
+    count = max(len(links) - 1, 1)
+    grid = CELL * count
+    scale_title = "sometimes: fraction of samples in collision (log scale); a cell holds the count"
+    legend_width = max(probe.textlength(scale_title, font=small),
+                       max(probe.textlength(text, font=font) for _, text in LEGEND) + 26,
+                       BAR_WIDTH + probe.textlength(f"{LIMIT_ONLY}  only at a joint limit", font=font) + 40)
+    width = int(max(MARGIN + label_width + grid + MARGIN, MARGIN + legend_width + MARGIN,
+                    MARGIN + (probe.textlength(title, font=font) if title else 0) + MARGIN))
+    legend_top = int(top + grid + 10 + label_width + 8)
+    rows_height = 20 * len(LEGEND)
+    scale_top = legend_top + rows_height + 8
+    height = scale_top + 18 + BAR_HEIGHT + 18 + MARGIN
+    image = Image.new("RGB", (width, height), "white")
     draw = ImageDraw.Draw(image)
     if title:
         draw.text((MARGIN, MARGIN), title, fill="black", font=font)
@@ -58,27 +113,56 @@ def heat_map_png(links: Sequence[str], pairs: Sequence[tuple[int, int]], results
         y = top + (row - 1) * CELL
         draw.text((left - 6, y + CELL / 2), links[row], fill="black", font=font, anchor="rm")
         for column in range(row):
-            result = cell[(column, row)]
+            result = cell.get((column, row))
             x = left + column * CELL
-            draw.rectangle((x, y, x + CELL - 2, y + CELL - 2), fill=cell_colour(result))
-            if result.category == "sometimes" and result.collisions:
-                percent = 100 * result.fraction
-                label = "<1" if percent < 0.5 else f"{percent:.0f}"
-                draw.text((x + CELL / 2 - 1, y + CELL / 2 - 1), label, fill="black", font=small, anchor="mm")
-    columns = Image.new("RGB", (int(label_width), CELL * max(len(links) - 1, 1)), "white")
+            if result is None:
+                continue
+            fill = cell_colour(result)
+            draw.rectangle((x, y, x + CELL - 2, y + CELL - 2), fill=fill)
+            text = cell_text(result)
+            chosen = font if len(text) <= 2 else small
+            if text and probe.textlength(text, font=chosen) <= CELL - 6:
+                draw.text((x + CELL / 2 - 1, y + CELL / 2 - 1), text, fill=_ink(fill), font=chosen, anchor="mm")
+    columns = Image.new("RGB", (int(label_width), grid), "white")
     column_draw = ImageDraw.Draw(columns)
     for column in range(len(links) - 1):
         column_draw.text((label_width - 6, column * CELL + CELL / 2), links[column], fill="black", font=font,
                          anchor="rm")
     image.paste(columns.rotate(90, expand=True), (int(left), int(top + grid + 6)))
-    y = top + grid + 10 + label_width
-    for name, colour in LEGEND:
-        draw.rectangle((MARGIN, y, MARGIN + 14, y + 14), fill=colour)
-        draw.text((MARGIN + 20, y + 7), name, fill="black", font=font, anchor="lm")
+    y = legend_top
+    for category, text in LEGEND:
+        colour = CATEGORY_COLOURS[category]
+        draw.rectangle((MARGIN, y, MARGIN + 16, y + 16), fill=colour)
+        letter = CATEGORY_LETTERS[category]
+        if letter:
+            draw.text((MARGIN + 8, y + 8), letter, fill=_ink(colour), font=small, anchor="mm")
+        draw.text((MARGIN + 24, y + 8), text, fill="black", font=font, anchor="lm")
         y += 20
-    buffer = io.BytesIO()
-    image.save(buffer, format="PNG")
-    return buffer.getvalue()
+    draw.text((MARGIN, scale_top), scale_title, fill="black", font=small)
+    bar_top = scale_top + 18
+    for i in range(BAR_WIDTH):
+        draw.line((MARGIN + i, bar_top, MARGIN + i, bar_top + BAR_HEIGHT), fill=ramp_colour(i / (BAR_WIDTH - 1)))
+    draw.rectangle((MARGIN, bar_top, MARGIN + BAR_WIDTH, bar_top + BAR_HEIGHT), outline=(90, 90, 90))
+    for tick in SCALE_TICKS:
+        x = MARGIN + scale_position(tick) * BAR_WIDTH
+        draw.line((x, bar_top + BAR_HEIGHT, x, bar_top + BAR_HEIGHT + 3), fill="black")
+        label = f"{100 * tick:g}%" if tick > SCALE_LOW else f"<= {100 * tick:g}%"
+        anchor = "la" if tick == SCALE_TICKS[0] else "ra" if tick == SCALE_TICKS[-1] else "ma"
+        draw.text((x, bar_top + BAR_HEIGHT + 4), label, fill="black", font=small, anchor=anchor)
+    swatch = MARGIN + BAR_WIDTH + 24
+    draw.rectangle((swatch, bar_top - 1, swatch + 16, bar_top + 15), fill=RAMP[0])
+    draw.text((swatch + 8, bar_top + 7), LIMIT_ONLY, fill="black", font=small, anchor="mm")
+    draw.text((swatch + 24, bar_top + 7), "only at a joint limit", fill="black", font=font, anchor="lm")
+    boxes = {"grid": (int(left), int(top), int(left + grid), int(top + grid)),
+             "legend": (MARGIN, legend_top, width - MARGIN, height - MARGIN),
+             "scale": (MARGIN, bar_top, MARGIN + BAR_WIDTH, bar_top + BAR_HEIGHT)}
+    return image, boxes
+
+
+def _ink(fill: tuple[int, int, int]) -> str:
+    """Black on light fills, white on dark ones."""
+    luminance = 0.299 * fill[0] + 0.587 * fill[1] + 0.114 * fill[2]
+    return "black" if luminance > 140 else "white"
 
 
 def _font(image_font, size: int):

@@ -1,12 +1,40 @@
-"""``ar3cli info``: the first look at a robot (tree, DOF, limits, mass, size, meshes), no pybullet."""
+"""``ar3cli info``: the first look at a robot (tree, DOF, limits, mass, size, meshes), no pybullet;
+``--torques`` adds the gravity torque check (pybullet, in a forked child), ``--png`` a picture of the tree."""
 
-from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.commands.options import (
+    FormatOption,
+    PackagePathOption,
+    RobotPathArgument,
+    SeedOption,
+    XacroArgOption,
+    samples_option,
+)
+from ar3cli.errors import UserError
 from ar3cli.output.report import OutputFormat, finish
 from ar3cli.urdf.loading import load_with_specs
+
+TorquesOption = Annotated[bool, typer.Option(
+    "--torques", help="Check that every actuated joint can hold the robot up: the largest gravity torque it needs "
+                      "(PyBullet's inverse dynamics, base fixed, at rest) over the home pose, the limit "
+                      "configurations and --samples uniform configurations, against its declared limit effort.")]
+SamplesOption = Annotated[int, samples_option("With --torques: uniform random configurations to check on top of "
+                                              "the home and limit configurations.", most=1_000_000)]
+PngOption = Annotated[Optional[Path], typer.Option(
+    "--png", metavar="OUT.png", dir_okay=False, show_default=False,
+    help="Draw the kinematic tree as a picture: link boxes, joints (name and type) on the edges.")]
 
 
 def info(
     path: RobotPathArgument,
+    torques: TorquesOption = False,
+    samples: SamplesOption = 200,
+    seed: SeedOption = 0,
+    png: PngOption = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     format: FormatOption = OutputFormat.text,
@@ -15,14 +43,39 @@ def info(
     bounding box, meshes, end effectors.
 
     Static and fast (no PyBullet): the centre of mass and the bounding box are computed at the
-    zero configuration (every joint at 0) with the URDF's own forward kinematics.
+    zero configuration (every joint at 0) with the URDF's own forward kinematics. --torques adds
+    the gravity torque check (PyBullet), --png a picture of the kinematic tree.
     """
     from ar3cli.info.summary import summarize
     from ar3cli.info.text import report
     from ar3cli.kinematics.fk import urdf_link_frames
 
+    if png is not None:
+        _check_png(png)
+
     def zero_frames(model):
         return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
 
     model = load_with_specs(path, package_path, xacro_arg)
-    finish(report(summarize(model, zero_frames), tree=format is OutputFormat.text), format)
+    summary = summarize(model, zero_frames)
+    check = None
+    if torques:
+        from ar3cli.info.torques import gravity_torques
+
+        check = gravity_torques(model, samples, seed)
+    if png is not None:
+        from ar3cli.info.tree_png import tree_png
+        from ar3cli.infra.atomic import atomic_write
+
+        atomic_write(png, tree_png(summary))
+    finish(report(summary, tree=format is OutputFormat.text, torques=check,
+                  picture=None if png is None else str(png)), format)
+
+
+def _check_png(png: Path) -> None:
+    """Refuse an unusable --png before any work."""
+    from ar3cli.infra.atomic import check_writable
+
+    if png.suffix.lower() != ".png":
+        raise UserError(f"--png {png}: the file name must end in .png")
+    check_writable(png)

@@ -6,16 +6,61 @@ from __future__ import annotations
 from typing import Any
 
 from ar3cli.info.summary import JointInfo, Summary
+from ar3cli.info.torques import TOO_WEAK, TorqueCheck
 from ar3cli.output.report import Report, Table, format_cell
 
 ONE_LINE_LIST = 12
 """Name lists longer than this are cut in the summary lines (the JSON has them all)."""
 
 
-def report(summary: Summary, tree: bool = True) -> Report:
-    """The Report for ``summary``; ``tree=False`` leaves the rich Tree out (JSON needs no rich)."""
-    return Report(data=summary.to_dict(), tables=[joint_table(summary), mass_table(summary)],
-                  renderables=[kinematic_tree(summary)] if tree else [], lines=summary_lines(summary))
+def report(summary: Summary, tree: bool = True, torques: TorqueCheck | None = None,
+           picture: str | None = None) -> Report:
+    """The Report for ``summary``; ``tree=False`` leaves the rich Tree out (JSON needs no rich).
+    ``torques`` adds the gravity torque table, its summary and warnings (JSON: ``torques``);
+    ``picture`` is the path of the tree picture written (JSON: ``png``)."""
+    data = summary.to_dict()
+    tables = [joint_table(summary), mass_table(summary)]
+    lines = summary_lines(summary)
+    if torques is not None:
+        data["torques"] = torques.to_dict()
+        tables.append(torque_table(torques))
+        lines += torque_lines(torques)
+    if picture is not None:
+        data["png"] = picture
+        lines.append(f"kinematic tree picture written to {picture}")
+    return Report(data=data, tables=tables, renderables=[kinematic_tree(summary)] if tree else [], lines=lines)
+
+
+def torque_table(check: TorqueCheck) -> Table:
+    rows = []
+    for joint in check.joints:
+        needed = f"{joint.needed:.4g} {joint.unit}"
+        effort = "-" if joint.effort is None else f"{joint.effort:g} {joint.unit}"
+        margin = "-" if joint.margin is None else f"{joint.margin:.3g}"
+        name = joint.name + (f" (follows {joint.mimic_of})" if joint.mimic_of else "")
+        rows.append([name, needed, joint.at, effort, margin, joint.status])
+    return Table(title=f"gravity torques: worst of {check.configurations} configurations "
+                       f"({check.limit_configurations} home/limit + {check.samples} samples, seed {check.seed})",
+                 columns=["joint", "max |torque| needed", "at", "declared effort", "margin", "status"], rows=rows,
+                 numeric_columns=("max |torque| needed", "declared effort", "margin"), status_column="status")
+
+
+def torque_lines(check: TorqueCheck) -> list[str]:
+    if not check.joints:
+        return ["gravity torques: no actuated joint"]
+    weak, missing = check.too_weak, check.without_effort
+    checked = [joint for joint in check.joints if joint.margin is not None]
+    line = (f"gravity torques: {len(check.joints) - len(weak) - len(missing)} of {_count(len(check.joints), 'joint')} "
+            "can hold the robot up")
+    if checked:
+        least = min(checked, key=lambda joint: joint.margin)  # type: ignore[arg-type,return-value]
+        line += f"; smallest margin {least.margin:.3g} ({least.name})"
+    lines = [line]
+    lines += [f"warning: joint {joint.name} is {TOO_WEAK}: it needs {joint.needed:.4g} {joint.unit} to hold the robot "
+              f"at '{joint.at}' but declares effort {joint.effort:g} {joint.unit}" for joint in weak]
+    if missing:
+        lines.append(f"no effort declared (limit effort missing or 0): {_names([joint.name for joint in missing])}")
+    return lines
 
 
 def joint_table(summary: Summary) -> Table:
