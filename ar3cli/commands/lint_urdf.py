@@ -19,6 +19,7 @@ class LintFormat(str, enum.Enum):
     sarif = "sarif"
     github = "github"
     markdown = "markdown"
+    junit = "junit"
 
 
 class FailOn(str, enum.Enum):
@@ -28,10 +29,12 @@ class FailOn(str, enum.Enum):
 
 
 def lint_urdf(
-    paths: Annotated[list[Path], typer.Argument(
-        metavar="PATH", help="URDF/xacro files, or folders searched for *.urdf and *.xacro.", show_default=False)],
+    paths: Annotated[Optional[list[Path]], typer.Argument(
+        metavar="PATH", help="URDF/xacro files, or folders searched for *.urdf and *.xacro (required, "
+                             "except with --explain).", show_default=False)] = None,
     format: Annotated[LintFormat, typer.Option("--format", "-f", help="text (table), json, sarif (SARIF 2.1.0), "
-                                                                      "github (workflow annotations) or markdown.")]
+                                                                      "github (workflow annotations), markdown or "
+                                                                      "junit (JUnit XML test report).")]
     = LintFormat.text,
     select: Annotated[Optional[list[str]], typer.Option("--select", metavar="CODES",
                                                         help="Only these rule codes or prefixes (comma-separated, "
@@ -62,6 +65,22 @@ def lint_urdf(
                                                        "one file as one row (count, first locations, message); on "
                                                        "by default. JSON, SARIF, github and markdown keep every "
                                                        "finding.", show_default=False)] = None,
+    baseline: Annotated[Optional[Path], typer.Option("--baseline", metavar="FILE",
+                                                     help="Do not report (or fail on) the findings this baseline "
+                                                          "file holds; only new ones count.", show_default=False)]
+    = None,
+    write_baseline: Annotated[Optional[Path], typer.Option("--write-baseline", metavar="FILE",
+                                                           help="Write every finding of this run to FILE as the "
+                                                                "baseline (for --baseline) and exit 0.",
+                                                           show_default=False)] = None,
+    changed_since: Annotated[Optional[str], typer.Option("--changed-since", metavar="REF",
+                                                         help="Only the robot files under PATH changed since this "
+                                                              "git ref (and untracked ones), and those using a "
+                                                              "changed mesh or included xacro file.",
+                                                         show_default=False)] = None,
+    explain: Annotated[Optional[str], typer.Option("--explain", metavar="CODE",
+                                                   help="Print a rule's documentation (why, fix, examples) and "
+                                                        "exit; takes no PATH.", show_default=False)] = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
 ) -> None:
@@ -70,6 +89,14 @@ def lint_urdf(
     Every finding has a stable rule code, a severity, a location and a fix; see docs/rules.md.
     Exit codes: 0 clean, 1 findings at or above --fail-on, 2 usage or I/O error.
     """
+    if explain is not None:
+        if paths:
+            raise UserError("--explain takes a rule code and no PATH")
+        explain_rule(explain, LintFormat(format))
+    if not paths:
+        raise UserError("missing PATH: give the URDF/xacro files or folders to check (or --explain CODE)")
+    if write_baseline is not None and changed_since is not None:
+        raise UserError("--write-baseline records every file, so it cannot be combined with --changed-since")
     from ar3cli.findings import Severity
     from ar3cli.lint.config import LintConfig, load_config
     from ar3cli.lint.engine import LintOptions, lint_paths, summarize
@@ -87,15 +114,126 @@ def lint_urdf(
     except ValueError as exc:
         raise UserError(str(exc)) from None
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
-    results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs)
-    if not results:
+    fmt = LintFormat(format)
+    accepted = None
+    if baseline is not None and write_baseline is None:
+        from ar3cli.lint.baseline import read_baseline
+
+        accepted = read_baseline(baseline)  # before linting: a broken baseline fails at once
+    selection = None
+    if changed_since is not None:
+        from ar3cli.lint.changed import select_changed
+
+        selection = select_changed(paths, changed_since, options.package_paths, options.xacro_args)
+        results = lint_paths(selection.files, options, use_cache=not no_cache, jobs=jobs) if selection.files else []
+        no_files = not selection.candidates
+    else:
+        results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs)
+        no_files = not results
+    if no_files:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
-    summary = summarize(results, threshold)
+    if write_baseline is not None:
+        _write_baseline(write_baseline, results, fmt)
+    held = None
+    if accepted is not None:
+        from ar3cli.lint.baseline import apply_baseline
+
+        results, baselined, unused = apply_baseline(results, accepted)
+        held = {"baselined": baselined, "baseline_unused": unused}
+    summary = {**summarize(results, threshold), **(held or {})}
     grouped = True if group is None else group
-    report = render_lint(results, summary, options, LintFormat(format), grouped=grouped)
+    if selection is not None and not results and fmt is LintFormat.text:
+        report = Report(data={}, lines=[changed_note(selection)])
+    else:
+        report = render_lint(results, summary, options, fmt, grouped=grouped)
+        if selection is not None:
+            report.data["changed_since"] = selection.to_dict()
+            if fmt is LintFormat.text:
+                report.lines.insert(0, changed_note(selection))
+            else:
+                from ar3cli.output.report import log
+
+                log(changed_note(selection))
     report.ok = report.ok or exit_zero
     report.errors = [*report.errors, *(result.error for result in results if result.error)]
-    finish(report, "json" if LintFormat(format) in (LintFormat.json, LintFormat.sarif) else "text")
+    finish(report, "json" if fmt in (LintFormat.json, LintFormat.sarif) else "text")
+
+
+def _write_baseline(path: Path, results, fmt: LintFormat) -> None:
+    """Write the baseline, say so in one line (or a JSON object), exit 0 (2 if a file's check crashed)."""
+    from ar3cli.lint.baseline import write_baseline
+
+    count, files = write_baseline(path, results)
+    line = (f"wrote {path}: {count} finding{'s' if count != 1 else ''} in {files} file{'s' if files != 1 else ''} "
+            f"({len(results)} checked); with --baseline {path} only new findings are reported")
+    data = {"baseline": str(path), "findings": count, "files_with_findings": files, "files": len(results)}
+    finish(Report(data=data, lines=[line], errors=[r.error for r in results if r.error]),
+           "json" if fmt is LintFormat.json else "text")
+
+
+def changed_note(selection) -> str:
+    """What --changed-since picked, in one line."""
+    head = f"--changed-since {selection.ref}:"
+    if not selection.files:
+        return (f"{head} no robot file under PATH changed or uses a changed file "
+                f"({selection.candidates} not checked); nothing to check")
+    parts = []
+    if selection.changed:
+        parts.append(f"{len(selection.changed)} changed ({_names(selection.changed)})")
+    if selection.dependents:
+        count = len(selection.dependents)
+        parts.append(f"{count} use{'s' if count == 1 else ''} a changed file ("
+                     + _names([f"{robot} uses {', '.join(used)}" for robot, used in selection.dependents.items()])
+                     + ")")
+    return f"{head} {len(selection.files)} of {selection.candidates} robot files: {'; '.join(parts)}"
+
+
+def _names(items: list[str], shown: int = 3) -> str:
+    return ", ".join(items[:shown]) + (f", and {len(items) - shown} more" if len(items) > shown else "")
+
+
+def explain_rule(code: str, fmt: LintFormat) -> None:
+    """``--explain CODE``: the rule's documentation in the terminal (or as JSON), exit 0."""
+    from ar3cli.lint.engine import find_rule, rule_document
+    from ar3cli.output.sarif import RULES_URL
+
+    document = rule_document(find_rule(code))
+    document["url"] = f"{RULES_URL}#{document['anchor']}"
+    if fmt is LintFormat.json:
+        finish(Report(data=document), "json")
+    finish(Report(data=document, text=explain_text(document)), "text")
+
+
+_SHOWN_FIRST = ("code", "name", "severity", "title", "why", "fix", "bad", "good", "needs_sim", "family", "anchor",
+                "url")
+_PARAGRAPHS = {"why": "Why it matters", "fix": "Fix", "fixed_by": "Fixed by", "thresholds": "Thresholds",
+               "references": "References"}
+
+
+def explain_text(document: dict) -> str:
+    """The terminal form of :func:`~ar3cli.lint.engine.rule_document`: the heading, then every
+    paragraph the rule has (fields added to Rule later included), the examples, the link."""
+    import textwrap
+
+    sim = "; runs only with --sim" if document.get("needs_sim") else ""
+    out = [f"{document['code']} {document['name']} ({document['severity']}, {document['family']}{sim})", "",
+           textwrap.fill(f"{document['title']}.", 100), ""]
+    extra = [key for key in document if key not in _SHOWN_FIRST and key not in _PARAGRAPHS]
+    for key in ("why", "fix", "fixed_by", "thresholds", "references", *extra):
+        value = document.get(key)
+        if value in (None, "", (), [], {}, False):
+            continue
+        label = _PARAGRAPHS.get(key) or key.replace("_", " ").capitalize()
+        if key == "fixed_by":
+            value = f"ar3cli {value}"
+        text = value if isinstance(value, str) else ", ".join(map(str, value)) if isinstance(value, (list, tuple)) \
+            else str(value)
+        out += [f"{label}:", textwrap.fill(text, 100, initial_indent="  ", subsequent_indent="  "), ""]
+    for key, label in (("bad", "Failing example"), ("good", "Passing example")):
+        if document.get(key):
+            out += [f"{label}:", textwrap.indent(document[key].rstrip("\n"), "  "), ""]
+    out.append(f"Docs: {document['url']}")
+    return "\n".join(out) + "\n"
 
 
 def _split(items: list[str] | None) -> list[str]:
@@ -110,8 +248,13 @@ def summary_line(summary: dict, cached: int = 0) -> str:
     verdict = "FAILED" if summary["failed"] or broken else "passed"
     unchecked = f"; {broken} not fully checked (pybullet crashed)" if broken else ""
     remembered = f"; {cached} unchanged since an earlier run (from the cache)" if cached else ""
+    held = ""
+    if summary.get("baselined") is not None:
+        unused = summary.get("baseline_unused") or 0
+        held = f"; {summary['baselined']} baselined" + (
+            f" ({unused} more in the baseline no longer found: --write-baseline drops them)" if unused else "")
     return (f"{verdict}: {files} file{'s' if files != 1 else ''} checked, {summary['error']} errors, "
-            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{unchecked}{remembered} "
+            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{held}{unchecked}{remembered} "
             f"(fail-on: {summary['fail_on']})")
 
 
@@ -127,6 +270,12 @@ def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool 
         from ar3cli.output.sarif import sarif_document
 
         return Report(data=sarif_document(findings, options.rules()), ok=ok)
+    if fmt is LintFormat.junit:
+        from ar3cli.findings import Severity
+        from ar3cli.output.junit import junit_document
+
+        document = junit_document([(r.path, r.findings, r.error) for r in results], Severity(summary["fail_on"]))
+        return Report(data=data, text=document, lines=[summary_line(summary)], ok=ok)
     if fmt in (LintFormat.github, LintFormat.markdown):
         from ar3cli.output.github import annotation, append_step_summary, markdown_table
 

@@ -451,3 +451,28 @@ def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
             "files_clean": sum(not r.findings and r.error is None for r in results),
             "findings": len(findings), **counts, "fail_on": fail_on.value,
             "failed": any(f.severity >= fail_on for f in findings)}
+
+
+def find_rule(code: str) -> Rule:
+    """The rule with this code (any case) or name; an unknown one is a one-line UserError."""
+    wanted = code.strip()
+    found = REGISTRY.get(wanted.upper()) or next((r for r in RULES if r.name == wanted.lower()), None)
+    if found is None:
+        raise UserError(f"unknown rule code {code!r} (codes look like F001 or J006; docs/rules.md lists them all)")
+    return found
+
+
+def rule_document(rule: Rule) -> dict[str, Any]:
+    """Every documentation field of ``rule`` (whatever fields :class:`Rule` has, its ``check``
+    aside), plus its family and docs anchor: what ``lint-urdf --explain`` shows."""
+    import dataclasses
+
+    document: dict[str, Any] = {}
+    for item in dataclasses.fields(rule):
+        value = getattr(rule, item.name)
+        if item.name == "check" or (callable(value) and not isinstance(value, (str, Severity))):
+            continue
+        document[item.name] = value.value if isinstance(value, Severity) else value
+    document["family"] = rule.family
+    document["anchor"] = rule.anchor
+    return document
