@@ -11,6 +11,7 @@ import sys
 import typer
 
 from ar3cli import __version__
+from ar3cli.commands.fix_collision import fix_collision
 from ar3cli.commands.fix_continuous import fix_continuous
 from ar3cli.commands.fix_inertia import fix_inertia
 from ar3cli.commands.fix_joints import fix_joints
@@ -59,6 +60,7 @@ app.command("fix-inertia")(fix_inertia)
 app.command("fix-continuous")(fix_continuous)
 app.command("fix-joints")(fix_joints)
 app.command("fix-mesh-paths")(fix_mesh_paths)
+app.command("fix-collision")(fix_collision)
 app.command("sample-collisions")(sample_collisions)
 
 

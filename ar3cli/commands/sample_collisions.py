@@ -33,7 +33,7 @@ SrdfOption = Annotated[Optional[Path], typer.Option("--srdf", metavar="OUT", dir
 SrdfMergeOption = Annotated[Optional[Path], typer.Option(
     "--srdf-merge", metavar="EXISTING.srdf", dir_okay=False, show_default=False,
     help="Merge the disabled pairs into a copy of this SRDF, written to --srdf OUT, which is required: give "
-         "the same path to update the file in place (atomically). Only <disable_collisions> with reason "
+         "the same path to update the file in place (atomically). Only `<disable_collisions>` with reason "
          "Adjacent, Default, Always or Never (what MoveIt Setup Assistant and ar3cli write) are replaced; "
          "groups, group states, end effectors, virtual and passive joints, comments and pairs with any "
          "other reason stay byte for byte.")]

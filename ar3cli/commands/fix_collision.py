@@ -1,0 +1,64 @@
+"""``ar3cli fix-collision``: replace non-convex collision meshes by a convex decomposition."""
+
+from typing import Annotated
+
+import typer
+
+from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.output.report import OutputFormat
+
+
+def fix_collision(
+    paths: FixPathsArgument,
+    max_hull_ratio: Annotated[float, typer.Option(
+        "--max-hull-ratio", help="Decompose a collision mesh whose convex hull has more than this many times "
+                                 "its volume (the mesh must be closed).")] = 2.0,
+    method: Annotated[str, typer.Option(
+        "--method", help="coacd, vhacd (pybullet's), or auto: coacd when installed (pip install "
+                         "'ar3cli[decompose]'), else vhacd.")] = "auto",
+    resolution: Annotated[int, typer.Option(
+        "--resolution", min=10_000, max=64_000_000,
+        help="vhacd's voxel count: higher is finer and slower.")] = 100_000,
+    from_visual: Annotated[bool, typer.Option(
+        "--from-visual", help="Links with a `<visual>` but no `<collision>` get one: a primitive copied, a mesh "
+                              "as its convex hull (decomposed when its hull ratio is above the limit).")] = False,
+    verify: Annotated[bool, typer.Option(
+        "--verify/--no-verify", help="After writing, load the result in PyBullet and count each changed "
+                                     "link's collision shapes.")] = True,
+    diff: DiffOption = False,
+    check: CheckOption = False,
+    output: OutputOption = None,
+    package_path: PackagePathOption = None,
+    format: FormatOption = OutputFormat.text,
+) -> None:
+    """Replace a collision mesh that collides as a much larger convex hull by convex parts.
+
+    PyBullet collides a moving link's mesh as its convex hull. Where hull volume / mesh volume is
+    above --max-hull-ratio, that `<collision>` becomes one `<collision>` per part of a convex
+    decomposition (CoACD or pybullet's V-HACD), written as OBJ files in
+    `collision/LINK/` beside the URDF; origin, scale and formatting are kept. With --diff or
+    --check nothing is written, part files included.
+    """
+    import tempfile
+    from pathlib import Path
+
+    from ar3cli.errors import UserError
+    from ar3cli.fix.collision_plan import CollisionOptions, make_fixer, remove_staging
+    from ar3cli.fix.collision_plan import verify as verify_in_pybullet
+    from ar3cli.fix.decompose import resolve_method
+    from ar3cli.fix.driver import run_fixer
+
+    if not max_hull_ratio > 1.0:
+        raise UserError(f"--max-hull-ratio {max_hull_ratio}: must be above 1 (a convex mesh is 1)")
+    options = CollisionOptions(max_hull_ratio=max_hull_ratio, method=resolve_method(method), resolution=resolution,
+                               from_visual=from_visual, output=output, write=not diff and not check,
+                               staging=Path(tempfile.mkdtemp(prefix="ar3cli-parts-")))
+    try:
+        code = run_fixer("fix-collision", paths, make_fixer(options), diff=diff, check=check, output=output,
+                         fmt=format, package_path=package_path, verifier=verify_in_pybullet if verify else None)
+    except BaseException:
+        options.rollback()  # part files of a URDF that was not rewritten
+        raise
+    finally:
+        remove_staging(options)
+    raise typer.Exit(code)
