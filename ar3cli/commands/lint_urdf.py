@@ -94,7 +94,8 @@ def lint_urdf(
             raise UserError("--explain takes a rule code and no PATH")
         explain_rule(explain, LintFormat(format))
     if not paths:
-        raise UserError("missing PATH: give the URDF/xacro files or folders to check, or --explain CODE (see 'ar3cli lint-urdf --help')")
+        raise UserError("missing PATH: give the URDF/xacro files or folders to check, or --explain CODE "
+                        "(see 'ar3cli lint-urdf --help')")
     if write_baseline is not None and changed_since is not None:
         raise UserError("--write-baseline records every file, so it cannot be combined with --changed-since")
     from ar3cli.findings import Severity
