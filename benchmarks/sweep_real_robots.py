@@ -37,7 +37,8 @@ Usage (inside the project's venv)::
     python benchmarks/sweep_real_robots.py --help
 
 Commands (``--commands``): lint-urdf, lint-urdf-sim, render, sample-collisions, fk-verify,
-fix-inertia, fix-continuous, install-check.
+fix-inertia, fix-continuous, fix-joints, fix-mesh-paths, fix-collision, info (with --torques),
+install-check.
 
 Time on 2 cores with --jobs 2: the static commands (lint-urdf, fix-inertia, fix-continuous) on the
 166 files take under 3 minutes (ar3cli's mesh cache starts empty in every sweep). The simulating
@@ -190,9 +191,28 @@ COMMANDS: tuple[Command, ...] = (
             lambda f, d: ["fix-inertia", f, "--diff", "--density", "1000", "--format", "json"]),
     Command("fix-continuous", "fix-continuous",
             lambda f, d: ["fix-continuous", f, "--diff", "--format", "json"]),
+    Command("fix-joints", "fix-joints",
+            lambda f, d: ["fix-joints", f, "--diff", "--format", "json"]),
+    Command("fix-mesh-paths", "fix-mesh-paths",
+            lambda f, d: ["fix-mesh-paths", f, "--diff", "--package", collection_package(f), "--format", "json"]),
+    Command("fix-collision", "fix-collision",
+            lambda f, d: ["fix-collision", f, "--diff", "--method", "vhacd", "--resolution", "20000",
+                          "--format", "json"]),
+    Command("info", "info --torques",
+            lambda f, d: ["info", f, "--torques", "--samples", "20", "--format", "json"]),
     Command("install-check", "install-check", lambda f, d: ["install-check", "--format", "json"],
             per_file=False),
 )
+
+
+def collection_package(robot_file: str) -> str:
+    """``--package NAME=DIR`` for fix-mesh-paths: the collection the file belongs to, as one package
+    (example-robot-data's share folder, or pybullet_data's)."""
+    path = Path(robot_file)
+    for parent in path.parents:
+        if parent.name in ("example-robot-data", "pybullet_data"):
+            return f"{parent.name}={parent}"
+    return f"robot={path.parent}"
 
 
 def pick_commands(spec: str | None) -> list[Command]:
@@ -441,6 +461,9 @@ CHECKS: dict[str, Callable[[object, int, Path], str]] = {
     "lint-urdf-sim": check_lint,
     "fix-inertia": check_fix,
     "fix-continuous": check_fix,
+    "fix-joints": check_fix,
+    "fix-mesh-paths": check_fix,
+    "fix-collision": check_fix,
 }
 
 
