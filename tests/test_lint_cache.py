@@ -26,10 +26,13 @@ MESH_ROBOT = """<?xml version="1.0"?>
 
 
 def write_stl(path: Path, size: float) -> None:
-    """An ASCII STL triangle spanning ``size`` (file units) along x, y and z."""
+    """A binary STL triangle spanning ``size`` (file units) along x, y and z (an ASCII STL is G011:
+    PyBullet and MuJoCo cannot read it)."""
+    import struct
+
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(f"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex {size} 0 0\n"
-                    f"vertex 0 {size} {size}\nendloop\nendfacet\nendsolid t\n", encoding="ascii")
+    corners = (0, 0, 0, size, 0, 0, 0, size, size)
+    path.write_bytes(b"t".ljust(80) + struct.pack("<I", 1) + struct.pack("<12f", 0, 0, 1, *corners) + b"\0\0")
 
 
 @pytest.fixture

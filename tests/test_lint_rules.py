@@ -49,11 +49,75 @@ def write_fixture(folder: Path, text: str, files: dict[str, bytes] | None = None
 
 def codes_for(path: Path, code: str) -> list:
     rule = REGISTRY[code]
-    options = LintOptions(sim=rule.needs_sim)
+    options = LintOptions(sim=rule.needs_sim, select=["ALL", code])  # naming the code runs an opt-in rule
     return [f for f in lint_file(path, options.rules(), options).findings if f.rule == code]
 
 
-EXTRA_FILES = {("G005", "bad"): {"meshes/base.stl": LFS_POINTER}}
+def test_opt_in_rules_run_only_when_named():
+    opt_in = {rule.code for rule in RULES if rule.opt_in}
+    assert opt_in == {"G012", "G013"}
+    assert not opt_in & {rule.code for rule in LintOptions().rules()}
+    assert not opt_in & {rule.code for rule in LintOptions(select=["G"]).rules()}
+    assert {rule.code for rule in LintOptions(select=["G013"]).rules()} == {"G013"}
+
+
+def binary_stl(triangles, header: bytes = b"ar3cli test fixture") -> bytes:
+    """A binary STL of ``triangles`` (each three (x, y, z) corners)."""
+    data = bytearray(header.ljust(80, b" ")[:80]) + struct.pack("<I", len(triangles))
+    for triangle in triangles:
+        data += struct.pack("<3f", 0, 0, 0)
+        for corner in triangle:
+            data += struct.pack("<3f", *corner)
+        data += b"\0\0"
+    return bytes(data)
+
+
+TETRAHEDRON = (((0, 0, 0), (0, 0.1, 0), (0.1, 0, 0)), ((0, 0, 0), (0.1, 0, 0), (0, 0, 0.1)),
+               ((0, 0, 0), (0, 0, 0.1), (0, 0.1, 0)), ((0.1, 0, 0), (0, 0.1, 0), (0, 0, 0.1)))
+"""A closed, outward-wound 10 cm tetrahedron."""
+
+
+def ascii_stl(triangles=TETRAHEDRON) -> bytes:
+    """The same triangles as an ASCII STL (PyBullet and MuJoCo cannot read it)."""
+    facets = "".join("  facet normal 0 0 0\n    outer loop\n"
+                     + "".join(f"      vertex {x:g} {y:g} {z:g}\n" for x, y, z in triangle)
+                     + "    endloop\n  endfacet\n" for triangle in triangles)
+    return f"solid part\n{facets}endsolid part\n".encode()
+
+
+def u_shape_stl() -> bytes:
+    """A closed U-shaped prism, 5 x 4 x 1 cm with 0.5 cm walls: its convex hull is 3.3x its volume.
+
+    The caps are made of quads whose corners are all outline vertices, so the surface is closed
+    without T-junctions."""
+    outline = [(0, 0), (0.5, 0), (4.5, 0), (5, 0), (5, 0.5), (5, 4), (4.5, 4), (4.5, 0.5), (0.5, 0.5), (0.5, 4),
+               (0, 4), (0, 0.5)]
+    quads = [[(0, 0), (0.5, 0), (0.5, 0.5), (0, 0.5)], [(0.5, 0), (4.5, 0), (4.5, 0.5), (0.5, 0.5)],
+             [(4.5, 0), (5, 0), (5, 0.5), (4.5, 0.5)], [(0, 0.5), (0.5, 0.5), (0.5, 4), (0, 4)],
+             [(4.5, 0.5), (5, 0.5), (5, 4), (4.5, 4)]]
+
+    def corner(point, z):
+        return point[0] / 100, point[1] / 100, z / 100
+
+    triangles = []
+    for a, b, c, d in quads:
+        triangles += [(corner(a, 1), corner(b, 1), corner(c, 1)), (corner(a, 1), corner(c, 1), corner(d, 1)),
+                      (corner(a, 0), corner(c, 0), corner(b, 0)), (corner(a, 0), corner(d, 0), corner(c, 0))]
+    for i, p in enumerate(outline):
+        q = outline[(i + 1) % len(outline)]
+        triangles += [(corner(p, 0), corner(q, 0), corner(q, 1)), (corner(p, 0), corner(q, 1), corner(p, 1))]
+    return binary_stl(triangles)
+
+
+MESHES = Path(__file__).parent / "data" / "meshes"
+"""Small OBJ and COLLADA fixtures (tests/data/meshes/README.md); STL fixtures are made above, as the
+repository keeps no .stl file (tests/test_assets.py)."""
+EXTRA_FILES = {
+    ("G005", "bad"): {"meshes/base.stl": LFS_POINTER},
+    ("G011", "bad"): {"meshes/part.stl": ascii_stl()},
+    ("G012", "bad"): {"meshes/flat.obj": (MESHES / "flat.obj").read_bytes()},
+    ("G013", "bad"): {"meshes/u_shape.stl": u_shape_stl()},
+}
 """Files a documented example needs beyond the standard meshes."""
 
 EXTRA_FAILING = [
@@ -153,4 +217,4 @@ def test_xacro_findings_point_into_the_xacro_source(tmp_path):
             '  <joint name="j1" type="revolute">\n    <parent link="base"/><child link="arm"/>\n'
             '    <limit lower="-1" upper="1" effort="${e}" velocity="1"/>\n  </joint>\n</robot>\n')
     (finding,) = codes_for(write_fixture(tmp_path, text), "J008")
-    assert finding.path.endswith("robot.urdf.xacro") and (finding.line, finding.column) == (6, 3)
+    assert finding.path.endswith("robot.urdf.xacro") and (finding.line, finding.column) == (8, 5)  # the <limit>

@@ -301,7 +301,8 @@ def _tensor_text(values: dict[str, str | None]) -> str:
 
 
 def links_needing_inertia(model: Model) -> dict[str, str]:
-    """``{link name: "CODE name: message"}`` for every link the lint inertia rules (I001-I007) flag.
+    """``{link name: "CODE name: message"}`` for every link the lint inertia rules that fix-inertia
+    fixes (``RULES`` of lint/rules/inertia.py: I001-I009) flag.
 
     The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
     so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.

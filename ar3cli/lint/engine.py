@@ -47,9 +47,11 @@ class LintOptions:
     xacro_args: Mapping[str, str] = field(default_factory=dict)
 
     def rules(self) -> list[Rule]:
-        """Selected rules in registry order; simulation rules only with ``sim``."""
+        """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
+        when ``select`` names their code."""
+        named = {code.upper() for code in self.select}
         return [r for r in RULES if matches(r.code, self.select) and not matches(r.code, self.ignore)
-                and (self.sim or not r.needs_sim)]
+                and (self.sim or not r.needs_sim) and (not r.opt_in or r.code in named)]
 
 
 @dataclass

@@ -11,8 +11,11 @@ from __future__ import annotations
 from ar3cli.lint.rules import file, geometry, inertia, joints, sim, structure
 from ar3cli.lint.rules.base import FAMILIES, Hit, Rule
 
-RULES: tuple[Rule, ...] = (*file.RULES, *structure.RULES, *joints.RULES, *inertia.RULES, *geometry.RULES,
-                           *sim.RULES)
+RULES: tuple[Rule, ...] = tuple(sorted(
+    (*file.RULES, *structure.RULES, *joints.RULES, *inertia.RULES, *inertia.NOT_FIXED_RULES, *geometry.RULES,
+     *sim.RULES), key=lambda r: ("FSJIGP".index(r.code[0]), r.code)))
+"""Every rule in family order, then by code (a family module may list its rules in another order:
+``inertia.RULES`` is fix-inertia's order of reasons)."""
 REGISTRY: dict[str, Rule] = {r.code: r for r in RULES}
 assert len(REGISTRY) == len(RULES), "duplicate rule code"
 

@@ -53,6 +53,13 @@ class Rule:
     ``bad`` and ``good`` are complete small URDF documents: the docs show them and the tests lint
     them (``bad`` must trigger the rule, ``good`` must not), so the documentation cannot drift.
     ``check`` is None for file rules the engine emits itself while loading.
+
+    Optional documentation, shown in docs/rules.md (and available to SARIF and other renderers):
+    ``fixed_by`` names the ar3cli command that fixes the finding (with the option it needs, if
+    any), ``thresholds`` the constants the rule compares against and their values, and
+    ``references`` the spec text or engine source the rule follows. ``opt_in`` rules run only
+    when their code is named in ``select`` (``--select G013``, not ``ALL`` or a prefix): they read
+    every collision mesh's triangles, which a cold lint of a large robot cannot afford by default.
     """
 
     code: str
@@ -65,6 +72,10 @@ class Rule:
     good: str
     check: Check | None = None
     needs_sim: bool = False
+    fixed_by: str | None = None
+    thresholds: str | None = None
+    references: str | None = None
+    opt_in: bool = False
 
     @property
     def family(self) -> str:
@@ -77,14 +88,17 @@ class Rule:
 
 
 def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str, bad: str, good: str,
-         needs_sim: bool = False) -> Callable[[Check | None], Rule]:
+         needs_sim: bool = False, fixed_by: str | None = None, thresholds: str | None = None,
+         references: str | None = None, opt_in: bool = False) -> Callable[[Check | None], Rule]:
     """Decorator turning a check function into a :class:`Rule` (the function's name is unused)."""
 
     def wrap(check: Check | None) -> Rule:
         return Rule(code=code, name=name, severity=Severity(severity), title=title,
                     why=" ".join(why.split()), fix=" ".join(fix.split()),
                     bad=textwrap.dedent(bad).strip() + "\n", good=textwrap.dedent(good).strip() + "\n",
-                    check=check, needs_sim=needs_sim)
+                    check=check, needs_sim=needs_sim, fixed_by=fixed_by,
+                    thresholds=" ".join(thresholds.split()) if thresholds else None,
+                    references=" ".join(references.split()) if references else None, opt_in=opt_in)
 
     return wrap
 

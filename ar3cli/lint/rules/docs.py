@@ -29,12 +29,27 @@ def generate() -> str:
             out += ["", f"## {family.capitalize()} ({prefix})"]
         out += [
             "", f"### {rule.code} {rule.name}", "",
-            f"**{rule.title}.** Severity: {rule.severity.value}." + (" Runs only with `--sim`." if rule.needs_sim else ""),
+            f"**{rule.title}.** Severity: {rule.severity.value}." + (" Runs only with `--sim`." if rule.needs_sim else "")
+            + (f" Opt-in: runs only when selected by its code (`--select {rule.code}`), as it reads every collision "
+               "mesh's triangles." if rule.opt_in else ""),
             "", f"**Why it matters.** {rule.why}", "", f"**Fix.** {rule.fix}", "",
+            *_optional(rule),
             "Failing example:", "", "```xml", rule.bad.rstrip("\n"), "```", "",
             "Passing example:", "", "```xml", rule.good.rstrip("\n"), "```",
         ]
     return "\n".join(out) + "\n"
+
+
+def _optional(rule) -> list[str]:
+    """The optional paragraphs: the fixing command, the thresholds, the references."""
+    out = []
+    if rule.fixed_by:
+        out += [f"**Fixed by.** `ar3cli {rule.fixed_by}`.", ""]
+    if rule.thresholds:
+        out += [f"**Thresholds.** {rule.thresholds}", ""]
+    if rule.references:
+        out += [f"**References.** {rule.references}", ""]
+    return out
 
 
 if __name__ == "__main__":

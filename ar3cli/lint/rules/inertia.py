@@ -13,11 +13,43 @@ IMPLAUSIBLE_FACTOR = 3.0
 """Radius of gyration above this many half-diagonals of the geometry's box cannot be real (see I007)."""
 TRIANGLE_TOLERANCE = 1e-3
 """Relative slack for A + B >= C: thin disks and rods sit exactly on the boundary, and files round."""
+MJ_MINVAL = 1e-15
+"""MuJoCo's ``mjMINVAL`` (mjtnum.h): a moving body whose mass or any principal moment is below it
+is refused ("mass and inertia of moving bodies must be larger than mjMINVAL", user_model.cc)."""
+EFFECTIVELY_ZERO = MJ_MINVAL
+"""kg·m²: a tensor whose every principal moment is smaller than this in magnitude is zero written
+with rounding noise (icub.urdf: (-1.355e-20, 0, 1.355e-20)). A 1 mg part 1 cm across already has
+1e-10; MuJoCo reads anything below mjMINVAL as zero."""
+NEAR_SINGULAR_RATIO = 1e-9
+"""Smallest / largest principal moment below which a tensor is near-singular. A real body cannot get
+there: a rod's ratio is 6 (r/L)², 1e-9 would be a 1 m rod 13 µm thick."""
+DUMMY_ROOT_NAMES = frozenset({"world", "map", "odom", "base_footprint", "dummy", "root", "base_root"})
+"""Root link names that are frames by convention (ROS REP 105 and KDL's "no inertia on the root")."""
 
 
 def _moving_links(model) -> dict[str, object]:
     """Link name -> the moving joint it hangs from."""
     return {joint.child: joint for joint in model.joints if joint.moves and joint.child}
+
+
+def _fixed_links(model) -> dict[str, object]:
+    """Link name -> the fixed joint it hangs from (welded to its parent: it never moves by itself)."""
+    return {joint.child: joint for joint in model.joints if joint.type == "fixed" and joint.child}
+
+
+def effectively_zero(moments) -> bool:
+    """True when every principal moment is below :data:`EFFECTIVELY_ZERO` in magnitude."""
+    return all(abs(m) < EFFECTIVELY_ZERO for m in moments)
+
+
+def near_singular(moments) -> bool:
+    """True for a positive tensor whose smallest moment is below mjMINVAL or 1e-9 of the largest."""
+    smallest, largest = moments[0], moments[-1]
+    return 0 < smallest < max(MJ_MINVAL, NEAR_SINGULAR_RATIO * largest) and not effectively_zero(moments)
+
+
+def _triangle_ok(inertial, moments) -> bool:
+    return moments[0] <= 0 or satisfies_triangle_inequality(inertial.matrix(), tol=TRIANGLE_TOLERANCE * moments[-1])
 
 
 @lru_cache(maxsize=4096)
@@ -40,7 +72,9 @@ def _fmt(moments) -> str:
       silently apart from a C-level warning. On a small arm that is kilograms of phantom mass at
       the wrist; MuJoCo instead computes it from the geometry at water density.""",
       fix="Add an <inertial> with the real mass, COM and tensor (ar3cli fix-inertia can compute one).",
-      bad=arm(link_extra=""), good=arm())
+      bad=arm(link_extra=""), good=arm(), fixed_by="fix-inertia",
+      references="PyBullet UrdfParser.cpp parseLink (no <inertial>: mass 1, inertia 1 unless the link is named "
+                 "'world'); docs/pybullet-facts.md.")
 def inertial_missing(ctx) -> Iterator[Hit]:
     moving = _moving_links(ctx.model)
     for link in ctx.model.links:
@@ -60,7 +94,8 @@ def inertial_missing(ctx) -> Iterator[Hit]:
       good=robot(f"""
           <link name="base">{LINK_INERTIAL}</link>
           <link name="tcp"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
-          <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""))
+          <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""),
+      fixed_by="fix-inertia")
 def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         link = ctx.model.link(joint.child) if joint.type == "fixed" and joint.child else None
@@ -76,7 +111,7 @@ def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
       following the physics), negative mass makes the dynamics diverge, and MuJoCo refuses both.""",
       fix="Set the link's real mass in kg.",
       bad=arm(link_extra='<inertial><mass value="0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'),
-      good=arm())
+      good=arm(), fixed_by="fix-inertia")
 def mass_not_positive(ctx) -> Iterator[Hit]:
     moving = _moving_links(ctx.model)
     for link in ctx.model.links:
@@ -91,23 +126,26 @@ def mass_not_positive(ctx) -> Iterator[Hit]:
 
 
 def _tensor_hits(ctx, test):
-    """Yield (link, inertial, moments) for links with a finite, non-zero tensor where ``test`` fails."""
+    """Yield (link, inertial, moments) for links with a finite tensor that is not (effectively) zero
+    where ``test`` fails; zero tensors are I006's and I008's."""
     for link in ctx.model.links:
         inertial = link.inertial
         if inertial is None or not finite_tensor(inertial.tensor) or not any(inertial.tensor):
             continue
         moments = tensor_moments(inertial.tensor)
-        if not test(inertial, moments):
+        if not effectively_zero(moments) and not test(inertial, moments):
             yield link, inertial, moments
 
 
 @rule("I004", "inertia-not-positive-definite", "error", "Inertia tensor is not positive definite",
       why="""Every principal moment of a real body is positive. A zero or negative one makes the
       mass matrix singular or indefinite: PyBullet warns and the simulation drifts or explodes,
-      MuJoCo and Drake refuse or substitute the tensor.""",
+      MuJoCo and Drake refuse or substitute the tensor. Tensors that are zero apart from rounding
+      noise (every moment below 1e-15) are I006's.""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="-0.01" iyz="0" izz="0.01"/></inertial>'),
-      good=arm())
+      good=arm(), fixed_by="fix-inertia",
+      thresholds="Tensors whose every principal moment is below EFFECTIVELY_ZERO = 1e-15 kg·m² are left to I006/I008.")
 def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
     for link, inertial, moments in _tensor_hits(ctx, lambda inertial, _m: is_positive_definite(inertial.matrix())):
         yield Hit(f"link '{link.name}' inertia is not positive definite: principal moments {_fmt(moments)}",
@@ -120,33 +158,109 @@ def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
       it ("inertia must satisfy A + B >= C") and PyBullet simulates a body that cannot exist.""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.05"/></inertial>'),
-      good=arm())
+      good=arm(), fixed_by="fix-inertia",
+      thresholds="A + B >= C - TRIANGLE_TOLERANCE x C, TRIANGLE_TOLERANCE = 1e-3; tensors whose every moment is "
+                 "below 1e-15 kg·m² are effectively zero (I006/I008), not triangle violations.")
 def inertia_triangle(ctx) -> Iterator[Hit]:
-    def ok(inertial, moments) -> bool:
-        return moments[0] <= 0 or satisfies_triangle_inequality(inertial.matrix(), tol=TRIANGLE_TOLERANCE * moments[-1])
-
-    for link, inertial, moments in _tensor_hits(ctx, ok):
+    for link, inertial, moments in _tensor_hits(ctx, _triangle_ok):
         a, b, c = moments
-        yield Hit(f"link '{link.name}' principal moments {_fmt(moments)}: {a:.4g} + {b:.4g} < {c:.4g}",
+        tiny = " (the two smallest are below MuJoCo's mjMINVAL 1e-15: a line, not a body)" if b < MJ_MINVAL else ""
+        yield Hit(f"link '{link.name}' principal moments {_fmt(moments)}: {a:.4g} + {b:.4g} < {c:.4g}{tiny}",
                   inertial.element.find("inertia"))
 
 
-@rule("I006", "inertia-zero", "error", "All-zero or missing inertia tensor with positive mass",
-      why="""A body with mass but no rotational inertia (ixx = iyy = izz = 0, or no <inertia>) is a
-      point mass: PyBullet divides by the zero moments and the joint accelerations blow up.""",
-      fix="Compute the tensor from the geometry (box: m(y²+z²)/12 ...; ar3cli fix-inertia).",
-      bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>'),
-      good=arm())
-def inertia_zero(ctx) -> Iterator[Hit]:
+def _zero_tensor_hits(ctx, on_fixed_links: bool) -> Iterator[Hit]:
+    """I006 and I008: positive mass with a missing, zero or effectively zero tensor."""
+    fixed = _fixed_links(ctx.model)
     for link in ctx.model.links:
         inertial = link.inertial
         if inertial is None or not (inertial.mass or 0) > 0:
             continue
         element = inertial.element.find("inertia")
         if element is None:
-            yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg but no <inertia>", inertial.element)
-        elif inertial.tensor is not None and not any(inertial.tensor):
-            yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg and an all-zero inertia tensor", element)
+            if not on_fixed_links:  # urdfdom refuses an <inertial> without <inertia>, fixed or not
+                yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg but no <inertia>", inertial.element)
+            continue
+        if (link.name in fixed) != on_fixed_links or not finite_tensor(inertial.tensor):
+            continue
+        where = f" on fixed joint '{fixed[link.name].name}'" if on_fixed_links else ""
+        if not any(inertial.tensor):
+            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and an all-zero inertia tensor", element)
+        elif effectively_zero(moments := tensor_moments(inertial.tensor)):
+            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and an effectively zero inertia "
+                      f"tensor: principal moments {_fmt(moments)}, all below {EFFECTIVELY_ZERO:g} kg·m²", element)
+
+
+_ZERO_TENSOR = '<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>'
+
+
+@rule("I006", "inertia-zero", "error", "Zero or missing inertia tensor with positive mass on a moving link",
+      why="""A body with mass but no rotational inertia (ixx = iyy = izz = 0, moments below 1e-15 that
+      are zero written with rounding noise, or no <inertia>) is a point mass. On a link that moves
+      (or on the root, which floats unless fixed by the loader) PyBullet divides by the zero moments
+      and the joint accelerations blow up; MuJoCo's URDF import reads an all-zero tensor as
+      "not given" and refuses a moving body whose moments are below mjMINVAL. urdfdom refuses an
+      <inertial> without <inertia> outright. Links welded to their parent by a fixed joint are
+      I008's.""",
+      fix="Compute the tensor from the geometry (box: m(y²+z²)/12 ...; ar3cli fix-inertia).",
+      bad=arm(link_extra=_ZERO_TENSOR),
+      good=arm(), fixed_by="fix-inertia",
+      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m² (MuJoCo's mjMINVAL).",
+      references="MuJoCo user_model.cc (moving bodies need mass and moments >= mjMINVAL) and xml_urdf.cc (an "
+                 "all-zero tensor is undefined); urdfdom link.cpp "
+                 "parseInertial (\"Inertial element must have inertia element\").")
+def inertia_zero(ctx) -> Iterator[Hit]:
+    yield from _zero_tensor_hits(ctx, on_fixed_links=False)
+
+
+@rule("I008", "inertia-zero-fixed-link", "info", "Zero inertia tensor with positive mass on a link on a fixed joint",
+      why="""A link welded to its parent by a fixed joint never rotates by itself: every engine
+      adds its mass to the parent's body (PyBullet and Drake weld it, MuJoCo can fuse it), where a point
+      mass at an offset is harmless. Still, the zero tensor is not the part's real inertia (sensor
+      frames and tool flanges often carry a placeholder mass), and the link becomes a problem the day
+      the joint is made movable.""",
+      fix="Compute the tensor from the geometry (ar3cli fix-inertia), or drop the mass if the link is a pure frame.",
+      bad=robot(f"""
+          <link name="base">{LINK_INERTIAL}</link><link name="flange">{_ZERO_TENSOR}</link>
+          <joint name="flange_joint" type="fixed"><parent link="base"/><child link="flange"/></joint>"""),
+      good=robot(f"""
+          <link name="base">{LINK_INERTIAL}</link><link name="flange">{LINK_INERTIAL}</link>
+          <joint name="flange_joint" type="fixed"><parent link="base"/><child link="flange"/></joint>"""),
+      fixed_by="fix-inertia",
+      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m².")
+def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
+    yield from _zero_tensor_hits(ctx, on_fixed_links=True)
+
+
+@rule("I009", "inertia-near-singular", "error", "Near-singular inertia tensor on a moving link",
+      why="""A principal moment below MuJoCo's mjMINVAL (1e-15 kg·m²) makes MuJoCo refuse a moving
+      body ("mass and inertia of moving bodies must be larger than mjMINVAL"; (2.2e-18, 0.215,
+      0.215) is refused). A moment below 1e-9 of the largest belongs to no real body (a rod's ratio
+      is 6(r/L)²): it is a typo or lost digits, and it makes the body's inertia ill-conditioned (condition
+      number above 1e9) where a solver inverts it: a floating base, a ball joint. Links on fixed
+      joints are exempt (their inertia is added to the parent's); tensors that also break A + B >= C
+      are I005's.""",
+      fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
+      bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="2.2e-18" ixy="0" ixz="0" iyy="0.215" iyz="0" izz="0.215"/></inertial>'),
+      good=arm(link_extra='<inertial><mass value="1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.215" iyz="0" izz="0.215"/></inertial>'),
+      fixed_by="fix-inertia",
+      thresholds="Smallest principal moment below MJ_MINVAL = 1e-15 kg·m², or below NEAR_SINGULAR_RATIO = 1e-9 "
+                 "times the largest, while the largest is at least 1e-15 (else I006/I008).",
+      references="MuJoCo include/mujoco/mjtnum.h (mjMINVAL) and src/user/user_model.cc (moving-body check).")
+def inertia_near_singular(ctx) -> Iterator[Hit]:
+    fixed = _fixed_links(ctx.model)
+
+    def ok(inertial, moments) -> bool:
+        return not near_singular(moments) or not _triangle_ok(inertial, moments)
+
+    for link, inertial, moments in _tensor_hits(ctx, ok):
+        if link.name in fixed or not (inertial.mass or 0) > 0:
+            continue
+        smallest, largest = moments[0], moments[-1]
+        why = (f"below MuJoCo's mjMINVAL {MJ_MINVAL:g}: MuJoCo refuses the body" if smallest < MJ_MINVAL else
+               f"{smallest / largest:.1e} of the largest: no real body is that thin")
+        yield Hit(f"link '{link.name}' principal moments {_fmt(moments)}: the smallest is {why}",
+                  inertial.element.find("inertia"))
 
 
 @rule("I007", "inertia-implausible", "warning", "Inertia implausible for the link's geometry",
@@ -157,7 +271,10 @@ def inertia_zero(ctx) -> Iterator[Hit]:
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="0.1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
                          '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'),
-      good=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision>'))
+      good=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision>'),
+      fixed_by="fix-inertia --include-implausible",
+      thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the link's "
+                 "geometry box (collision shapes, else visual).")
 def inertia_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
         inertial = link.inertial
@@ -178,5 +295,90 @@ def inertia_implausible(ctx) -> Iterator[Hit]:
                       f"I_max {moments[-1]:.3g} kg·m²)", inertial.element.find("inertia"))
 
 
+@rule("I010", "mass-zero-with-inertia", "info", "Mass 0 with a non-zero inertia tensor",
+      why="""mass 0 with a non-zero tensor contradicts itself. PyBullet reads it as the author
+      meant: a mass-0 root is static (its idiom for tables and planes) and a mass-0 link on a fixed
+      joint adds nothing; MuJoCo's URDF import fixes the root to the world and merges fixed links,
+      so it agrees. Drake does not: it cannot re-express the
+      tensor about the centre of mass (it divides by the mass), warns, and substitutes a 1 kg sphere
+      of water density, so the static object falls and a tool flange adds a kilogram to the arm. On a
+      moving link mass 0 is I003's; the reverse, a positive mass with a zero tensor, is I006/I008.""",
+      fix="Decide which is true: give the real mass, or set the tensor to zero as well (a massless frame or a "
+          "static object).",
+      bad=robot('''<link name="table"><inertial><mass value="0"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>
+          <collision><geometry><box size="1 1 0.1"/></geometry></collision></link>'''),
+      good=robot('''<link name="table"><inertial><mass value="0"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>
+          <collision><geometry><box size="1 1 0.1"/></geometry></collision></link>'''),
+      references="Drake multibody/parsing/detail_common.cc ParseSpatialInertia (\"While re-expressing as central "
+                 "inertia\": plausible sphere substituted).")
+def mass_zero_with_inertia(ctx) -> Iterator[Hit]:
+    moving = _moving_links(ctx.model)
+    for link in ctx.model.links:
+        inertial = link.inertial
+        if inertial is None or link.name in moving or inertial.mass != 0 or link.name == "world" \
+                or not finite_tensor(inertial.tensor) or effectively_zero(tensor_moments(inertial.tensor)):
+            continue
+        effect = ("PyBullet adds nothing to the parent" if ctx.model.parent_joint(link.name) is not None
+                  else "a static body in PyBullet")
+        yield Hit(f"link '{link.name}' has mass 0 but inertia {_fmt(tensor_moments(inertial.tensor))}: {effect}, "
+                  "a 1 kg sphere in Drake", inertial.element.find("mass"))
+
+
+@rule("I011", "world-inertial", "warning", "<inertial> on the link named 'world'",
+      why="""A link named "world" is the world itself in Drake, MuJoCo and Gazebo, not a body:
+      Drake ignores its <inertial> with a warning, KDL (robot_state_publisher, MoveIt) cannot give
+      the root link an inertia and ignores it too. PyBullet alone uses it: with useFixedBase=False the
+      "world" becomes a floating body of that mass. The file means different robots in different
+      tools.""",
+      fix="Remove the <inertial> from the world link; put the mass on the robot's first real link.",
+      bad=robot(f'''<link name="world">{LINK_INERTIAL}</link><link name="base">{LINK_INERTIAL}</link>
+          <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>'''),
+      good=robot(f'''<link name="world"/><link name="base">{LINK_INERTIAL}</link>
+          <joint name="fix" type="fixed"><parent link="world"/><child link="base"/></joint>'''),
+      references="Drake multibody/parsing/detail_urdf_parser.cc ParseBody (\"The <inertial> tag is being "
+                 "ignored\"); kdl_parser (\"KDL does not support a root link with an inertia\").")
+def world_inertial(ctx) -> Iterator[Hit]:
+    for link in ctx.model.links:
+        if link.name == "world" and link.inertial is not None:
+            yield Hit("link 'world' has an <inertial>: Drake and KDL ignore it, PyBullet makes it a body",
+                      link.inertial.element)
+
+
+def _looks_like_frame(link) -> bool:
+    return not link.has_geometry or link.name.lower() in DUMMY_ROOT_NAMES
+
+
+@rule("I012", "root-inertial-missing", "info", "Root link with geometry but no <inertial>",
+      why="""This matters only if the robot floats (a mobile base, a legged robot, an object to
+      grasp); most arms are loaded with a fixed base and can ignore it. Loaded with
+      useFixedBase=False, PyBullet gives a root without <inertial> 1 kg and I = (1, 1, 1), silently
+      apart from a C-level warning; Drake makes it a massless free body, whose dynamics are
+      singular. (MuJoCo's URDF import fixes the root to the world whatever its mass.)
+      Roots without geometry (world, base_footprint: frames by ROS convention, where KDL wants no
+      inertia) are not reported.""",
+      fix="If the robot floats, give the root link its real <inertial> (ar3cli fix-inertia --links ROOT computes one "
+          "from the geometry); if it is always fixed to the world, nothing to do.",
+      bad=robot('''<link name="chassis"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
+      good=robot(f'''<link name="chassis">{LINK_INERTIAL}<collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
+      thresholds="Frame roots are skipped: no visual or collision geometry, or a name in DUMMY_ROOT_NAMES "
+                 "(world, map, odom, base_footprint, dummy, root, base_root).",
+      references="PyBullet UrdfParser.cpp parseLink (mass 1, inertia 1 without <inertial>); Drake "
+                 "multibody/parsing/detail_urdf_parser.cc ParseBody (no <inertial>: zero spatial inertia).")
+def root_inertial_missing(ctx) -> Iterator[Hit]:
+    roots = ctx.model.root_links()
+    if len(roots) != 1:
+        return  # no root or several: S005's business
+    root = roots[0]
+    if root.inertial is None and not _looks_like_frame(root):
+        yield Hit(f"root link '{root.name}' has geometry but no <inertial>: if this robot floats, PyBullet gives it "
+                  "1 kg and I = 1, Drake no mass at all", root.element,
+                  hint=f"If the robot floats: ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write "
+                       "the real <inertial>); a fixed-base arm can ignore this.")
+
+
 RULES = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,
-         inertia_triangle, inertia_zero, inertia_implausible)
+         inertia_triangle, inertia_zero, inertia_zero_fixed_link, inertia_near_singular, inertia_implausible)
+"""The rules whose links fix-inertia recomputes (:func:`ar3cli.fix.inertia_plan.links_needing_inertia`),
+in its order of reasons: I007 last, so a link reported as I007 has nothing invalid."""
+NOT_FIXED_RULES = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
+"""Inertia findings fix-inertia leaves alone: the fix is a decision only the author can make."""

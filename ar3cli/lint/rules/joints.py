@@ -10,8 +10,16 @@ from ar3cli.urdf.model import ACTUATED_JOINT_TYPES as ACTUATED_TYPES
 
 LIMITED_TYPES = ("revolute", "prismatic")
 """The types the URDF spec requires a <limit> with lower/upper on."""
-DEGREE_THRESHOLD = 2 * math.pi + 0.01
-"""A revolute limit beyond one full turn is almost always a value in degrees."""
+RADIAN_PLAUSIBLE = 4 * math.pi
+"""rad: multi-turn joints have real limits up to two turns each way (±3π on ANYmal, ±10 on Solo and
+Bolt, (-3.05, 6.81) on TIAGo's hand, ±6.3 on many wrists): a limit within ±4π is taken as radians."""
+DEGREE_PLAUSIBLE = 720.0
+"""A degree limit beyond two turns each way is not a typed angle (±1e16 is "unlimited")."""
+DEGREE_STEP = 5.0
+"""Angles typed in degrees are round: 90, 135, 170, 180, 270, 360 are multiples of 5."""
+WHEEL_LIKE = ("wheel", "caster", "castor", "roller", "rotor", "propeller", "prop_", "tire", "tyre", "track",
+              "gear", "pulley", "spinner")
+"""Name fragments of links that spin without stops by design (J011)."""
 
 
 @rule("J001", "limit-missing", "error", "Revolute or prismatic joint without <limit>",
@@ -45,7 +53,8 @@ def limit_range_missing(ctx) -> Iterator[Hit]:
       why="""With lower > upper, PyBullet treats the joint as unlimited and MuJoCo disables the
       limit; samplers drawing uniform(lower, upper) fail or sample nonsense.""",
       fix="Swap lower and upper.",
-      bad=arm(joint_extra='<limit lower="1" upper="-1" effort="10" velocity="1"/>'), good=arm())
+      bad=arm(joint_extra='<limit lower="1" upper="-1" effort="10" velocity="1"/>'), good=arm(),
+      fixed_by="fix-joints")
 def limit_inverted(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         limit = joint.limit
@@ -67,20 +76,35 @@ def limit_empty(ctx) -> Iterator[Hit]:
             yield Hit(f"joint '{joint.name}' has lower == upper == {limit.lower:g}: it cannot move", limit.element)
 
 
+def _looks_like_degrees(value: float) -> bool:
+    """Implausible as radians (beyond ±4π) and plausible as typed degrees (a multiple of 5 up to 720)."""
+    magnitude = abs(value)
+    if not RADIAN_PLAUSIBLE < magnitude <= DEGREE_PLAUSIBLE:
+        return False
+    return abs(magnitude / DEGREE_STEP - round(magnitude / DEGREE_STEP)) < 1e-9
+
+
 @rule("J005", "limit-degrees", "warning", "Revolute limits that look like degrees",
-      why="""URDF angles are radians. A revolute limit beyond ±2π (one full turn) is almost always a
-      value typed in degrees: 90 means 14 turns.""",
+      why="""URDF angles are radians. A revolute limit of 90 or 180 is almost always a value typed in
+      degrees: 90 rad is 14 turns. Multi-turn joints legitimately go beyond ±2π (±3π, ±10, -3.05 to
+      6.81 are real radian limits), so only values that cannot be radians for a robot joint
+      (beyond ±4π) and look like typed degrees (a round number up to 720) are reported.""",
       fix="Convert to radians (degrees × π/180).",
-      bad=arm(joint_extra='<limit lower="-90" upper="90" effort="10" velocity="1"/>'), good=arm())
+      bad=arm(joint_extra='<limit lower="-90" upper="90" effort="10" velocity="1"/>'),
+      good=arm(joint_extra='<limit lower="-9.42478" upper="9.42478" effort="10" velocity="1"/>'),
+      thresholds="A value v is reported when RADIAN_PLAUSIBLE = 4π < |v| <= DEGREE_PLAUSIBLE = 720 and v is a "
+                 "multiple of DEGREE_STEP = 5.",
+      fixed_by="fix-joints")
 def limit_degrees(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         limit = joint.limit
         if joint.type != "revolute" or limit is None:
             continue
         values = [v for v in (limit.lower, limit.upper) if v is not None and math.isfinite(v)]
-        if any(abs(v) > DEGREE_THRESHOLD for v in values):
+        if any(map(_looks_like_degrees, values)):
             shown = ", ".join(f"{v:g}" for v in values)
-            yield Hit(f"revolute joint '{joint.name}' limits ({shown}) exceed ±2π rad; degrees?", limit.element,
+            yield Hit(f"revolute joint '{joint.name}' limits ({shown}) look like degrees: {max(map(abs, values)):g} rad "
+                      f"is {max(map(abs, values)) / (2 * math.pi):.0f} turns", limit.element,
                       hint=f"In radians: {', '.join(f'{math.radians(v):.4f}' for v in values)}.")
 
 
@@ -91,7 +115,8 @@ def limit_degrees(ctx) -> Iterator[Hit]:
       should be revolute.""",
       fix="Remove lower/upper, or make the joint revolute with its real limits.",
       bad=arm(joint_type="continuous", joint_extra='<limit lower="-100" upper="100" effort="10" velocity="1"/>'),
-      good=arm(joint_type="continuous", joint_extra='<limit effort="10" velocity="1"/>'))
+      good=arm(joint_type="continuous", joint_extra='<limit effort="10" velocity="1"/>'),
+      fixed_by="fix-continuous")
 def continuous_with_range(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         limit = joint.limit
@@ -106,7 +131,8 @@ def continuous_with_range(ctx) -> Iterator[Hit]:
       why="""effort and velocity are required attributes of <limit>: urdfdom refuses the file, and
       PyBullet reads 0 (no force, no speed for controllers that use them).""",
       fix="Add effort (N·m or N) and velocity (rad/s or m/s) from the actuator's datasheet.",
-      bad=arm(joint_extra='<limit lower="-1" upper="1"/>'), good=arm())
+      bad=arm(joint_extra='<limit lower="-1" upper="1"/>'), good=arm(),
+      fixed_by="fix-joints --limits-from joint_limits.yaml")
 def effort_velocity_missing(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         if joint.limit is None or joint.type not in ACTUATED_TYPES:
@@ -148,7 +174,9 @@ def axis_zero(ctx) -> Iterator[Hit]:
       (KDL does, some IK and Jacobian code does not), so a non-unit axis scales velocities in some
       tools only.""",
       fix="Normalise the axis (divide by its length).",
-      bad=arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 2"/>'), good=arm())
+      bad=arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 2"/>'), good=arm(),
+      thresholds="Length differing from 1 by more than 1e-3.",
+      fixed_by="fix-joints")
 def axis_not_unit(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         if joint.type not in ACTUATED_TYPES or not joint.axis_given:
@@ -160,33 +188,68 @@ def axis_not_unit(ctx) -> Iterator[Hit]:
                       hint=f'Use <axis xyz="{unit}"/>.')
 
 
-@rule("J011", "continuous-arm-joint", "warning", "Continuous joint without <limit> inside a chain",
+@rule("J011", "continuous-arm-joint", "warning", "Continuous joint without <limit> inside an arm-like chain",
       why="""A continuous joint with no <limit> at all that carries further moving joints is the
       signature of a CAD export: SolidWorks' sw_urdf_exporter writes every joint as continuous with
       no limits unless told otherwise. Arm joints almost always have hard stops; planners then
-      wrap through them, and PyBullet reports effort 0 and velocity 0. Wheels and turntables at
-      the end of a chain, and continuous joints that state effort/velocity, are not flagged.""",
+      wrap through them, and PyBullet reports effort 0 and velocity 0. Joints that spin by design are
+      not flagged: wheels and turntables at the end of a chain, caster swivels, differentials and
+      pendulums (a wheel-like link below: named wheel, caster, roller, rotor, gear ..., or a cylinder
+      or sphere spinning on a continuous joint at the end of the chain), and the virtual joints of a
+      planar or floating base (the parent is a link without geometry that itself moves).""",
       fix="Make it revolute with the real lower/upper/effort/velocity from the datasheet.",
       bad=robot(f"""
-          <link name="base"/><link name="upper">{LINK_INERTIAL}</link><link name="fore">{LINK_INERTIAL}</link>
+          <link name="base"/><link name="upper">{LINK_INERTIAL}<visual><geometry><box size="0.1 0.1 0.3"/></geometry></visual></link>
+          <link name="fore">{LINK_INERTIAL}<visual><geometry><box size="0.1 0.1 0.3"/></geometry></visual></link>
           <joint name="shoulder" type="continuous"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/></joint>
           <joint name="elbow" type="continuous"><parent link="upper"/><child link="fore"/><axis xyz="0 1 0"/></joint>"""),
       good=robot(f"""
-          <link name="base"/><link name="upper">{LINK_INERTIAL}</link><link name="fore">{LINK_INERTIAL}</link>
-          <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><axis xyz="0 0 1"/>
-            <limit lower="-2.9" upper="2.9" effort="20" velocity="1"/></joint>
-          <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><axis xyz="0 1 0"/>
-            <limit lower="-2" upper="2" effort="10" velocity="1"/></joint>"""))
+          <link name="base"><visual><geometry><box size="0.4 0.4 0.1"/></geometry></visual></link>
+          <link name="caster_swivel">{LINK_INERTIAL}</link>
+          <link name="caster_wheel">{LINK_INERTIAL}<collision><geometry><cylinder radius="0.04" length="0.02"/></geometry></collision></link>
+          <joint name="swivel" type="continuous"><parent link="base"/><child link="caster_swivel"/><axis xyz="0 0 1"/></joint>
+          <joint name="spin" type="continuous"><parent link="caster_swivel"/><child link="caster_wheel"/><axis xyz="0 1 0"/></joint>"""),
+      fixed_by="fix-continuous --limits-from joint_limits.yaml",
+      thresholds="Wheel-like names: " + ", ".join(WHEEL_LIKE) + ".")
 def continuous_arm_joint(ctx) -> Iterator[Hit]:
     model = ctx.model
     for joint in model.joints:
         if joint.type != "continuous" or joint.limit is not None or not joint.child:
             continue
         downstream = _moving_descendants(model, joint.child)
-        if downstream:
+        if downstream and not _virtual_base_joint(model, joint) and _wheel_like_below(model, joint.child) is None:
             yield Hit(f"continuous joint '{joint.name}' has no <limit> and carries {downstream} more moving joint"
-                      f"{'s' if downstream != 1 else ''}: an arm joint with no stops, effort 0 and velocity 0 "
-                      "in PyBullet", joint.element)
+                      f"{'s' if downstream != 1 else ''} and no wheel: an arm joint with no stops, effort 0 and "
+                      "velocity 0 in PyBullet", joint.element)
+
+
+def _virtual_base_joint(model, joint) -> bool:
+    """True for a joint of a virtual base chain: its parent link has no geometry and itself moves."""
+    parent = model.link(joint.parent) if joint.parent else None
+    if parent is None or parent.has_geometry:
+        return False
+    above = model.parent_joint(parent.name)
+    return above is not None and above.moves
+
+
+def _wheel_like_below(model, link_name: str) -> str | None:
+    """The first link at or below ``link_name`` that spins by design (see J011), or None."""
+    stack, seen = [link_name], {link_name}
+    while stack:
+        name = stack.pop()
+        if any(fragment in name.lower() for fragment in WHEEL_LIKE):
+            return name
+        link = model.link(name)
+        above = model.parent_joint(name)
+        if link is not None and above is not None and above.type == "continuous" and not _moving_descendants(model, name):
+            shapes = link.collisions or link.visuals
+            if shapes and all(shape.geometry.kind in ("cylinder", "sphere") for shape in shapes):
+                return name
+        for child in model.child_joints(name):
+            if child.child and child.child not in seen:
+                seen.add(child.child)
+                stack.append(child.child)
+    return None
 
 
 def _moving_descendants(model, link_name: str) -> int:
@@ -201,5 +264,74 @@ def _moving_descendants(model, link_name: str) -> int:
     return count
 
 
+SINGLE_DOF_TYPES = ACTUATED_TYPES
+"""The joint types a <mimic> can couple: one position each (Drake refuses anything else)."""
+
+
+def _mimic_robot(follower_type: str, leader_type: str) -> str:
+    def limit(kind: str) -> str:
+        return '<limit lower="-1" upper="1" effort="10" velocity="1"/>' if kind in ("revolute", "prismatic") else ""
+
+    return robot(f"""
+        <link name="base">{LINK_INERTIAL}</link><link name="left">{LINK_INERTIAL}</link><link name="right">{LINK_INERTIAL}</link>
+        <joint name="left_finger" type="{leader_type}"><parent link="base"/><child link="left"/><axis xyz="0 1 0"/>{limit(leader_type)}</joint>
+        <joint name="right_finger" type="{follower_type}"><parent link="base"/><child link="right"/><axis xyz="0 1 0"/>{limit(follower_type)}
+          <mimic joint="left_finger" multiplier="-1"/></joint>""")
+
+
+@rule("J012", "mimic-not-single-dof", "error", "<mimic> on, or of, a joint that is not revolute, continuous or prismatic",
+      why="""A mimic couples one joint position to another: both joints must have exactly one degree
+      of freedom. Drake refuses a file where a fixed joint mimics a moving one or a moving joint
+      mimics a fixed one ("Joint 'a' which has 0 DOF cannot mimic joint 'b' which has 1 DOF"), and
+      ignores mimics between multi-DOF or fixed joints with a warning; MoveIt and
+      joint_state_publisher compute the follower from a leader that never moves. PyBullet ignores
+      <mimic> altogether. A mimic of a joint that does not exist is S007's.""",
+      fix="Put the <mimic> on the moving follower joint and name a moving leader joint, or remove it.",
+      bad=_mimic_robot("fixed", "revolute"), good=_mimic_robot("revolute", "revolute"),
+      references="Drake multibody/parsing/detail_urdf_parser.cc ParseMimicTag; URDF spec joint/mimic "
+                 "(wiki.ros.org/urdf/XML/joint).")
+def mimic_not_single_dof(ctx) -> Iterator[Hit]:
+    model = ctx.model
+    for joint in model.joints:
+        if joint.mimic is None:
+            continue
+        leader = model.joint(joint.mimic.joint)
+        if joint.type not in SINGLE_DOF_TYPES:
+            target = f"'{leader.name}' ({leader.type})" if leader is not None else f"'{joint.mimic.joint}'"
+            yield Hit(f"{joint.type or 'untyped'} joint '{joint.name}' has a <mimic> of {target}: only revolute, "
+                      "continuous and prismatic joints can follow another", joint.mimic.element)
+        elif leader is not None and leader is not joint and leader.type not in SINGLE_DOF_TYPES:
+            yield Hit(f"joint '{joint.name}' mimics {leader.type or 'untyped'} joint '{leader.name}': Drake refuses it "
+                      f"({joint.type} has 1 DOF, {leader.type} does not)", joint.mimic.element)
+
+
+PORTABILITY = {
+    "floating": "PyBullet turns it into a fixed joint (\"joint unsupported, creating a fixed joint instead\", "
+                "measured with pybullet 3.2.7); Drake ignores it and leaves the child a free body; MuJoCo makes "
+                "it a free joint, allowed only on a top-level body; KDL (robot_state_publisher) treats it as "
+                "fixed; Pinocchio makes it a free flyer",
+    "planar": "PyBullet and Drake make it a planar joint; MuJoCo builds two slides and a hinge; KDL "
+              "(robot_state_publisher, MoveIt's KDL plugin) treats it as fixed",
+}
+"""What each engine does with the URDF joint types outside the 1-DOF family (J013)."""
+
+
+@rule("J013", "joint-type-portability", "info", "Planar or floating joint: engines disagree on it",
+      why="""planar and floating are URDF joint types, but few engines treat them alike: PyBullet
+      turns a floating joint into a fixed one (measured: "Warning: joint unsupported, creating a
+      fixed joint instead"), Drake ignores floating joints, MuJoCo accepts a free joint only on a
+      top-level body, and KDL-based ROS tools treat both types as fixed. None of them needs a <limit>
+      on these joints (PyBullet 3.2.7 loads planar, floating and spherical joints without one). The
+      PyBullet-only spherical type is S010's.""",
+      fix="Keep it if your target engine supports it; for a mobile base prefer a floating root (no joint) and let "
+          "the simulator or a planar controller move it.",
+      bad=arm(joint_type="floating", joint_extra=""), good=arm())
+def joint_type_portability(ctx) -> Iterator[Hit]:
+    for joint in ctx.model.joints:
+        if joint.type in PORTABILITY:
+            yield Hit(f"{joint.type} joint '{joint.name}': {PORTABILITY[joint.type]}", joint.element)
+
+
 RULES = (limit_missing, limit_range_missing, limit_inverted, limit_empty, limit_degrees, continuous_with_range,
-         effort_velocity_missing, effort_velocity_zero, axis_zero, axis_not_unit, continuous_arm_joint)
+         effort_velocity_missing, effort_velocity_zero, axis_zero, axis_not_unit, continuous_arm_joint,
+         mimic_not_single_dof, joint_type_portability)

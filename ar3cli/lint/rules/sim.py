@@ -106,7 +106,8 @@ def _depth_text(depth: float) -> str:
       bad=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.1 0.1 1"/></geometry></collision>'),
       good=arm(link_extra='<inertial><mass value="1"/><inertia ixx="0.08378" ixy="0" ixz="0" iyy="0.08378" iyz="0" '
                           'izz="0.001768"/></inertial><collision><geometry><box size="0.1 0.1 1"/></geometry></collision>'),
-      needs_sim=True)
+      needs_sim=True,
+      thresholds="Relative difference above INERTIA_TOLERANCE = 0.10 between the file's and PyBullet's mass or principal moments.")
 def sim_inertia_differs(ctx) -> Iterator[Hit]:
     """One finding per file: how many links PyBullet's default load changes, pointing at the worst one.
 
@@ -159,7 +160,8 @@ def _differs(used: float, declared: float) -> bool:
       fix="Look at the I and J findings for this file (inertia, mass, axis); fix-inertia often cures it.",
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="1e-9" ixy="0" ixz="0" iyy="1e-9" iyz="0" izz="1e-9"/>'
                          '</inertial>').replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'),
-      good=arm(), needs_sim=True)
+      good=arm(), needs_sim=True,
+      thresholds='A joint NaN/inf, or faster than MAX_SETTLE_SPEED = 100 rad/s or m/s, after SETTLE_STEPS = 240 steps (1 s) under gravity.')
 def sim_unstable(ctx) -> Iterator[Hit]:
     with _loaded(ctx) as body:
         if body is None or not body.actuated_joints:

@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterator
 
-from ar3cli.lint.rules.base import Hit, arm, robot, rule
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 from ar3cli.urdf.model import URDF_JOINT_TYPES
 
 JOINT_TYPES = URDF_JOINT_TYPES
@@ -144,14 +144,20 @@ def not_a_tree(ctx) -> Iterator[Hit]:
                 yield Hit(f"joints form a cycle through links {' -> '.join(loop)} -> {link}", joint.element)
 
 
-@rule("S007", "unknown-joint-reference", "error", "Mimic or transmission names an unknown joint",
-      why="""A <mimic joint="..."> or a <transmission> <joint name="..."> that names no joint is
-      ignored by some tools and an error in others (ros_control refuses to start).""",
-      fix="Fix the joint name in the mimic/transmission, or remove it.",
+@rule("S007", "unknown-joint-reference", "error", "Reference to a joint or link that does not exist",
+      why="""A <mimic joint="...">, a <transmission> <joint name="...">, a <ros2_control> <joint
+      name="..."> or a <gazebo reference="..."> that names no joint (or link) is ignored by some
+      tools and an error in others: ros_control and ros2_control refuse to start, Drake refuses a
+      transmission or mimic of a missing joint, and Gazebo applies the <gazebo> block (friction,
+      material, sensor, plugin) to nothing, without a word.""",
+      fix="Fix the name (check the spelling and any xacro prefix), or remove the element.",
       bad=arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><mimic joint="j0"/>'),
-      good=arm())
+      good=arm(),
+      references="Drake multibody/parsing/detail_urdf_parser.cc (ParseMimicTag, ParseTransmission: \"which does not "
+                 "exist\"); gazebo_ros_control default_robot_hw_sim.cpp (\"which is not in the gazebo model\").")
 def unknown_joint_reference(ctx) -> Iterator[Hit]:
     names = {joint.name for joint in ctx.model.joints}
+    links = {link.name for link in ctx.model.links}
     for joint in ctx.model.joints:
         if joint.mimic is not None and joint.mimic.joint not in names:
             yield Hit(f"joint '{joint.name}' mimics unknown joint '{joint.mimic.joint}'", joint.mimic.element)
@@ -162,6 +168,15 @@ def unknown_joint_reference(ctx) -> Iterator[Hit]:
             name = element.get("name")
             if name not in names:
                 yield Hit(f"transmission '{transmission.get('name', '?')}' names unknown joint '{name}'", element)
+    for block in ctx.model.root.iter("ros2_control"):
+        for element in block.findall("joint"):
+            name = element.get("name")
+            if name not in names:
+                yield Hit(f"ros2_control '{block.get('name', '?')}' names unknown joint '{name}'", element)
+    for block in ctx.model.root.iter("gazebo"):
+        reference = block.get("reference")
+        if reference is not None and reference not in links and reference not in names:
+            yield Hit(f"<gazebo reference=\"{reference}\"> names no link or joint: Gazebo applies it to nothing", block)
 
 
 @rule("S008", "undefined-material", "info", "Material used but never defined",
@@ -219,5 +234,176 @@ def no_links(ctx) -> Iterator[Hit]:
         yield Hit("<robot> has no <link> elements", ctx.model.root)
 
 
+def _transmissions(model):
+    """(transmission element, its type, its joint names, its actuator elements) for every <transmission>."""
+    for transmission in model.root.iter("transmission"):
+        type_element = transmission.find("type")
+        kind = (type_element.text or "") if type_element is not None else transmission.get("type", "")
+        joints = [element.get("name") for element in transmission.iter("joint")]
+        actuators = [element for tag in ("actuator", "leftActuator", "rightActuator")
+                     for element in transmission.iter(tag)]
+        yield transmission, kind.strip(), joints, actuators
+
+
+def _transmission_robot(second: str) -> str:
+    return robot(f"""
+        <link name="base"/><link name="arm">{LINK_INERTIAL}</link><link name="tool">{LINK_INERTIAL}</link>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+          <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+        <joint name="tool_joint" type="fixed"><parent link="arm"/><child link="tool"/></joint>
+        <transmission name="t1"><type>transmission_interface/SimpleTransmission</type>
+          <joint name="j1"><hardwareInterface>hardware_interface/EffortJointInterface</hardwareInterface></joint>
+          <actuator name="m1"><mechanicalReduction>1</mechanicalReduction></actuator></transmission>
+        {second}""")
+
+
+@rule("S012", "transmission-fixed-joint", "warning", "Transmission on a fixed joint",
+      why="""A fixed joint has nothing to drive. Drake skips the transmission ("Skipping transmission
+      since it's attached to a fixed joint"); Gazebo merges fixed joints away when it converts the
+      URDF, so gazebo_ros_control refuses to start ("This robot has a joint named ... which is not in
+      the gazebo model") and gz_ros2_control skips the joint; a ros_control controller for it never
+      moves anything.""",
+      fix="Remove the transmission, or make the joint the moving type it really is.",
+      bad=_transmission_robot("""<transmission name="t2"><type>transmission_interface/SimpleTransmission</type>
+          <joint name="tool_joint"/><actuator name="m2"/></transmission>"""),
+      good=_transmission_robot(""),
+      references="Drake multibody/parsing/detail_urdf_parser.cc ParseTransmission; gazebo_ros_control "
+                 "default_robot_hw_sim.cpp.")
+def transmission_fixed_joint(ctx) -> Iterator[Hit]:
+    for transmission, _kind, joints, _actuators in _transmissions(ctx.model):
+        for name in joints:
+            joint = ctx.model.joint(name) if name else None
+            if joint is not None and joint.type == "fixed":
+                yield Hit(f"transmission '{transmission.get('name', '?')}' drives fixed joint '{name}'", transmission)
+
+
+@rule("S013", "duplicate-actuator", "error", "Two transmissions name the same actuator",
+      why="""A SimpleTransmission couples one actuator to one joint. Two of them that name the same
+      actuator make two motors of one: Drake refuses the file ("already contains a joint actuator
+      named ... Joint actuator names must be unique"), and ros_control registers the actuator twice,
+      so one joint's commands go to the other. Transmissions of other types may share a motor by
+      design (PAL's Hey5Reducer drives five finger joints from one motor) and are not checked.""",
+      fix="Give every actuator its own name (usually JOINT_motor), or merge the transmissions.",
+      bad=_transmission_robot(f"""<link name="arm2">{LINK_INERTIAL}</link>
+          <joint name="j2" type="revolute"><parent link="arm"/><child link="arm2"/><axis xyz="0 1 0"/>
+            <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <transmission name="t2"><type>transmission_interface/SimpleTransmission</type>
+            <joint name="j2"/><actuator name="m1"/></transmission>"""),
+      good=_transmission_robot(""),
+      thresholds="Only transmissions whose type contains SimpleTransmission are compared.",
+      references="Drake multibody/tree/multibody_tree.cc AddJointActuator (unique names); Drake "
+                 "detail_urdf_parser.cc ParseTransmission (SimpleTransmission only).")
+def duplicate_actuator(ctx) -> Iterator[Hit]:
+    owner: dict[str, str] = {}
+    for transmission, kind, _joints, actuators in _transmissions(ctx.model):
+        if "SimpleTransmission" not in kind:
+            continue  # other types may share a motor by design (PAL's Hey5Reducer: one motor, five finger joints)
+        name = transmission.get("name", "?")
+        for element in actuators:
+            actuator = element.get("name")
+            if not actuator:
+                continue
+            if actuator in owner and owner[actuator] != name:
+                yield Hit(f"transmission '{name}' names actuator '{actuator}', already driven by transmission "
+                          f"'{owner[actuator]}'", element)
+            owner.setdefault(actuator, name)
+
+
+SINGLE_CHILDREN = {
+    "joint": ("origin", "parent", "child", "axis", "calibration", "dynamics", "limit", "safety_controller", "mimic"),
+    "link": ("inertial",),
+    "inertial": ("origin", "mass", "inertia"),
+    "visual": ("origin", "geometry", "material"),
+    "collision": ("origin", "geometry"),
+}
+"""Element -> the children the URDF spec allows at most once (wiki.ros.org/urdf/XML/joint, /link)."""
+
+
+@rule("S014", "duplicate-element", "warning", "Element given twice where the spec allows one",
+      why="""urdfdom, PyBullet, Drake and MuJoCo read the first <axis>, <origin>, <limit>,
+      <inertial> or <mass> of an element (TinyXML's FirstChildElement) and ignore the others without
+      a word, so a second one (a xacro macro and its caller both adding <limit>, a pasted
+      <inertial>) is dead text that looks like it matters. Which one wins depends on document order,
+      not on intent.""",
+      fix="Keep the one you mean and delete the others.",
+      bad=arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/>'
+                          '<limit lower="-2" upper="2" effort="10" velocity="1"/>'),
+      good=arm(),
+      thresholds="Single children: " + "; ".join(f"<{parent}>: {', '.join(children)}"
+                                                 for parent, children in SINGLE_CHILDREN.items()) + ".")
+def duplicate_element(ctx) -> Iterator[Hit]:
+    for parent_tag, children in SINGLE_CHILDREN.items():
+        for parent in ctx.model.root.iter(parent_tag):
+            if parent_tag in ("joint", "link") and parent.getparent() is not ctx.model.root:
+                continue  # <joint> inside <transmission> or <ros2_control> is another element
+            counts = Counter(child.tag for child in parent if isinstance(child.tag, str))
+            for tag in children:
+                if counts[tag] > 1:
+                    extra = [child for child in parent if child.tag == tag][1]
+                    owner = _owner_name(parent)
+                    yield Hit(f"{owner} has {counts[tag]} <{tag}> elements: every parser reads the first and ignores "
+                              "the rest", extra)
+    for geometry in ctx.model.root.iter("geometry"):
+        shapes = [child for child in geometry if isinstance(child.tag, str)]
+        if len(shapes) > 1:
+            yield Hit(f"{_owner_name(geometry)} has {len(shapes)} children ({', '.join(child.tag for child in shapes)}): "
+                      "parsers read the first as the shape and ignore the rest", shapes[1])
+
+
+def _owner_name(element) -> str:
+    """'joint 'j1'' / 'link 'arm' <visual>' for messages."""
+    node, path = element, []
+    while node is not None and node.tag not in ("link", "joint"):
+        path.append(node.tag)
+        node = node.getparent()
+    if node is None:
+        return f"<{element.tag}>"
+    inner = "".join(f" <{tag}>" for tag in reversed(path))
+    return f"{node.tag} '{node.get('name', '?')}'{inner}"
+
+
+@rule("S015", "link-order", "info", "Root link not first, or a link declared before its parent",
+      why="""URDF does not order links, and ar3cli does not care (it hands pybullet a reordered copy).
+      But pybullet loaded with URDF_MAINTAIN_LINK_ORDER, which keeps link indices in file order,
+      crashes in C (SIGSEGV, no message) when the root is not the first <link> (every UR file of
+      example-robot-data, TIAGo, Talos), and gives NaN frames to a link declared before its parent
+      and to everything below it (pybullet 3.2.7, docs/pybullet-facts.md). Listing links parent
+      first, root first, makes the file safe for every loader.""",
+      fix="Move the root <link> to the top and list every link after its parent (ar3cli works around it; other "
+          "pybullet users need this).",
+      bad=robot("""
+          <link name="tool"/><link name="base"/>
+          <joint name="j" type="fixed"><parent link="base"/><child link="tool"/></joint>"""),
+      good=robot("""
+          <link name="base"/><link name="tool"/>
+          <joint name="j" type="fixed"><parent link="base"/><child link="tool"/></joint>"""),
+      references="docs/pybullet-facts.md (link order and URDF_MAINTAIN_LINK_ORDER); tests/data/link_order/.")
+def link_order(ctx) -> Iterator[Hit]:
+    model = ctx.model
+    roots = model.root_links()
+    if len(roots) != 1 or len(model.links) < 2:
+        return  # S005/S011's business
+    position = {}
+    for index, link in enumerate(model.links):
+        position.setdefault(link.name, index)
+    parent_of: dict[str, str] = {}
+    for joint in model.joints:  # the first parent joint of each link (a second one is S006's)
+        if joint.child and joint.parent:
+            parent_of.setdefault(joint.child, joint.parent)
+    early = sorted(((model.link(child), parent) for child, parent in parent_of.items()
+                    if child in position and parent in position and position[child] < position[parent]),
+                   key=lambda pair: position[pair[0].name])
+    if model.links[0] is not roots[0]:
+        also = f" ({len(early)} link{'s' if len(early) != 1 else ''} declared before their parent too)" if early else ""
+        yield Hit(f"root link '{roots[0].name}' is not the first <link> ('{model.links[0].name}' is){also}: pybullet "
+                  "with URDF_MAINTAIN_LINK_ORDER crashes on this file", roots[0].element)
+    elif early:
+        link, parent = early[0]
+        more = f" ({len(early) - 1} more link{'s' if len(early) > 2 else ''} too)" if len(early) > 1 else ""
+        yield Hit(f"link '{link.name}' is declared before its parent '{parent}'{more}: pybullet with "
+                  "URDF_MAINTAIN_LINK_ORDER gives it and the links below it NaN frames", link.element)
+
+
 RULES = (robot_name, duplicate_link, duplicate_joint, missing_link, several_roots, not_a_tree,
-         unknown_joint_reference, undefined_material, joint_type, pybullet_joint_type, no_links)
+         unknown_joint_reference, undefined_material, joint_type, pybullet_joint_type, no_links,
+         transmission_fixed_joint, duplicate_actuator, duplicate_element, link_order)
