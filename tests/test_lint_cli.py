@@ -22,7 +22,7 @@ def test_json_document_and_exit_code(cli, write_urdf):
     doc = json.loads(result.stdout)
     assert set(doc) == {"files", "findings", "summary"}
     (finding,) = [f for f in doc["findings"] if f["rule"] == "J001"]
-    assert set(finding) == {"path", "line", "column", "rule", "severity", "message", "hint"}
+    assert set(finding) == {"path", "line", "column", "rule", "severity", "message", "hint", "fixed_by"}
     assert finding["severity"] == "error" and finding["line"] == 5 and "'j1'" in finding["message"]
     assert doc["summary"]["error"] >= 1 and doc["summary"]["failed"] is True
 
@@ -268,3 +268,13 @@ def test_select_never_hides_a_file_that_cannot_be_loaded(cli, tmp_path):
     assert selected.code == 1 and [f["rule"] for f in json.loads(selected.stdout)["findings"]] == ["F002"]
     ignored = cli("lint-urdf", str(junk), "--select", "I", "--ignore", "F002", "--format", "json")
     assert ignored.code == 0 and json.loads(ignored.stdout)["findings"] == []
+
+
+def test_fix_hint_prints_the_command_lines_that_fix_the_findings(cli):
+    """Issue 17: each rule names its fixer; --fix-hint turns a file's findings into command lines."""
+    broken = "assets/examples/ar3_no_inertia.urdf"  # shown as given, relative to the working folder
+    text = cli("lint-urdf", broken, "--fix-hint", "--no-cache")
+    assert f"to fix: ar3cli fix-inertia {broken} --density KG_PER_M3  # I001" in text.stdout
+    data = json.loads(cli("lint-urdf", broken, "--fix-hint", "--no-cache", "--format", "json").stdout)
+    assert data["fix_commands"] == [f"ar3cli fix-inertia {broken} --density KG_PER_M3  # I001"]
+    assert {f["fixed_by"] for f in data["findings"]} == {"fix-inertia"}

@@ -60,6 +60,9 @@ def lint_urdf(
     no_cache: Annotated[bool, typer.Option("--no-cache", help="Check every file again instead of reusing the "
                                                               "findings of unchanged files from earlier runs "
                                                               "(also AR3CLI_NO_CACHE=1).")] = False,
+    fix_hint: Annotated[bool, typer.Option("--fix-hint", help="After the findings, print the ar3cli command "
+                                                               "lines that fix them, one per fixer and file "
+                                                               "(JSON: fix_commands).")] = False,
     group: Annotated[Optional[bool], typer.Option("--group/--no-group",
                                                   help="Text format: show 5 or more alike findings of one rule in "
                                                        "one file as one row (count, first locations, message); on "
@@ -155,6 +158,12 @@ def lint_urdf(
                 from ar3cli.output.report import log
 
                 log(changed_note(selection))
+    if fix_hint and fmt in (LintFormat.text, LintFormat.json):
+        from ar3cli.lint.fix_hints import fix_commands
+
+        commands = [line for result in results for line in fix_commands(result.path, result.findings)]
+        report.data["fix_commands"] = commands
+        report.lines += [f"to fix: {line}" for line in commands] or ["to fix: no finding has an ar3cli fixer"]
     report.ok = report.ok or exit_zero
     report.errors = [*report.errors, *(result.error for result in results if result.error)]
     finish(report, "json" if fmt in (LintFormat.json, LintFormat.sarif) else "text")
@@ -264,8 +273,11 @@ def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool 
     annotations and markdown as verbatim stdout text (github also appends the Markdown table to
     ``$GITHUB_STEP_SUMMARY`` when set). ``grouped`` folds alike findings into one text row
     (:func:`~ar3cli.lint.engine.group_findings`); every other format keeps every finding."""
+    from ar3cli.lint.fix_hints import fixed_by
+
     findings = [f for result in results for f in result.findings]
-    data = {"files": [r.to_dict() for r in results], "findings": [f.to_dict() for f in findings], "summary": summary}
+    data = {"files": [r.to_dict() for r in results],
+            "findings": [{**f.to_dict(), "fixed_by": fixed_by(f.rule)} for f in findings], "summary": summary}
     ok = not summary["failed"]
     if fmt is LintFormat.sarif:
         from ar3cli.output.sarif import sarif_document
