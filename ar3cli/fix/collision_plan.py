@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped
+from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, verified_in_pybullet
 from ar3cli.fix.edits import Document, Span
 
 MAX_HULL_RATIO = 2.0
@@ -410,20 +410,13 @@ def remove_staging(options: CollisionOptions) -> None:
 def verify(model, plan: FixPlan) -> dict:
     """Load the written file in PyBullet (in a child); every changed link must have one collision
     shape per ``<collision>``, the part files among them."""
-    from ar3cli.sim.session import run_pybullet
-
     links = plan.context.get("links", {})
     if not links:
         return {"verified": True, "checks": []}
     expected = {link.name: len(link.collisions) for link in model.links if link.name in links}
     files = {name: [str(Path(model.resolver.resolve(uri).path or uri).resolve()) for uri in uris or []]
              for name, uris in links.items()}
-    try:
-        checks = run_pybullet(lambda: _checks_in_pybullet(model, expected, files), model)
-    except UserError as exc:
-        message = exc.message.removeprefix(f"{model.path}: ")  # the path of the temporary file
-        return {"verified": False, "checks": [_check("(the file)", "loaded", False, message)], "error": message}
-    return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, expected, files))
 
 
 def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[str]]) -> list[dict]:
@@ -435,7 +428,7 @@ def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[s
         p, client = session.p, session.client
         for name, count in expected.items():
             if name not in body.link_index:
-                checks.append(_check(f"link {name}", "collision shapes", False, "link not found in pybullet"))
+                checks.append(check_row(f"link {name}", "collision shapes", False, "link not found in pybullet"))
                 continue
             shapes = p.getCollisionShapeData(body.id, body.link_index[name], physicsClientId=client)
             loaded = {str(Path(s[4].decode("utf-8", "replace")).resolve()) for s in shapes if s[4]}
@@ -446,9 +439,7 @@ def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[s
                 detail += f"; not loaded: {', '.join(missing)}"
             elif files.get(name):
                 detail += f", {len(files[name])} part file(s) loaded"
-            checks.append(_check(f"link {name}", "collision shapes", ok, detail))
+            checks.append(check_row(f"link {name}", "collision shapes", ok, detail))
     return checks
 
 
-def _check(element: str, check: str, ok: bool, detail: str) -> dict:
-    return {"joint": element, "check": check, "status": "ok" if ok else "fail", "detail": detail}

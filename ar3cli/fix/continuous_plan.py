@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
+from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
 from ar3cli.fix.edits import Document
 
 FULL_TURN = 2.0 * math.pi
@@ -238,16 +238,10 @@ def _full_turn_to_continuous(document: Document, plan: FixPlan, joint) -> None:
 def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; check each changed joint's limits (and that a target
     beyond a removed fake limit is reached)."""
-    from ar3cli.sim.session import run_pybullet
-
     joints = plan.context.get("joints", {})
     if not joints:
         return {"verified": True, "checks": []}
-    try:
-        checks = run_pybullet(lambda: _checks_in_pybullet(model, joints), model)
-    except UserError as exc:
-        return {"verified": False, "checks": [], "error": exc.message}
-    return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, joints))
 
 
 def _checks_in_pybullet(model, joints: dict) -> list[dict]:
@@ -262,30 +256,28 @@ def _checks_in_pybullet(model, joints: dict) -> list[dict]:
         for name, expected in joints.items():
             record = records.get(name)
             if record is None:
-                checks.append(_check(name, "loaded", False, "joint not found in pybullet"))
+                checks.append(check_row(name, "loaded", False, "joint not found in pybullet"))
                 continue
             info = p.getJointInfo(body.id, record.index, physicsClientId=session.client)
             lower, upper = info[8], info[9]
             if expected["expect"] == "continuous":
-                checks.append(_check(name, "no position limit", lower > upper,
+                checks.append(check_row(name, "no position limit", lower > upper,
                                      f"getJointInfo lower={lower:g} upper={upper:g}"))
                 old_upper = expected.get("old_upper")
                 if old_upper is not None and old_upper < FULL_TURN:
                     target = old_upper + 0.5
                     reached = _drive(session, body, record.index, target)
-                    checks.append(_check(name, "target beyond old limit", abs(reached - target) < 1e-2,
+                    checks.append(check_row(name, "target beyond old limit", abs(reached - target) < 1e-2,
                                          f"target {target:.4g} rad, reached {reached:.4g} rad "
                                          f"(old upper {old_upper:g})"))
             else:
                 ok = math.isclose(lower, expected["lower"], abs_tol=1e-9) and math.isclose(
                     upper, expected["upper"], abs_tol=1e-9)
-                checks.append(_check(name, f"{expected['expect']} limits", ok,
+                checks.append(check_row(name, f"{expected['expect']} limits", ok,
                                      f"getJointInfo lower={lower:.9g} upper={upper:.9g}"))
     return checks
 
 
-def _check(joint: str, check: str, ok: bool, detail: str) -> dict:
-    return {"joint": joint, "check": check, "status": "ok" if ok else "fail", "detail": detail}
 
 
 def _drive(session, body, index: int, target: float, steps: int = 2400) -> float:

@@ -87,6 +87,27 @@ class FixResult:
         return data
 
 
+def check_row(element: str, check: str, ok: bool, detail: str) -> dict[str, str]:
+    """One row of a verifier's report: what was checked on which element, ok or fail, and why."""
+    return {"element": element, "check": check, "status": "ok" if ok else "fail", "detail": detail}
+
+
+def verified_in_pybullet(model: Any, checks: Callable[[], list[dict[str, str]]]) -> dict[str, Any]:
+    """Run a verifier's ``checks()`` (pybullet work on the fixed file) in a contained child.
+
+    A file pybullet cannot load, or crashes on, is one failed row as well as ``error`` (the text
+    output shows the rows); the temporary file's path is left out of the message.
+    """
+    from ar3cli.sim.session import run_pybullet
+
+    try:
+        rows = run_pybullet(checks, model)
+    except UserError as exc:
+        message = exc.message.removeprefix(f"{model.path}: ")
+        return {"verified": False, "checks": [check_row("(the file)", "loaded", False, message)], "error": message}
+    return {"verified": all(row["status"] == "ok" for row in rows), "checks": rows}
+
+
 def same_numbers(old: str | None, new: str, rel_tol: float, abs_tol: float = 0.0) -> bool:
     """True when the old attribute text already says the new numbers (so nothing is rewritten):
     same count of whitespace-separated numbers, each equal within the tolerances."""
@@ -246,14 +267,14 @@ def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, 
         for s in r.plan.skipped:
             skipped_rows.append([str(r.path), s.element, s.line, s.reason])
         for check_row in (r.verification or {}).get("checks", []):
-            verify_rows.append([str(r.path), check_row["joint"], check_row["check"], check_row["status"],
+            verify_rows.append([str(r.path), check_row["element"], check_row["check"], check_row["status"],
                                 check_row["detail"]])
     verb = {"diff": "would change", "check": "would change", "write": "changed"}[mode]
     tables = [Table(f"ar3cli {command}: {verb}", ["file", "element", "line", "field", "old", "new", "source"], rows)]
     if skipped_rows:
         tables.append(Table("not fixed", ["file", "element", "line", "reason"], skipped_rows))
     if verify_rows:
-        tables.append(Table("verified in PyBullet", ["file", "joint", "check", "status", "detail"], verify_rows,
+        tables.append(Table("verified in PyBullet", ["file", "element", "check", "status", "detail"], verify_rows,
                             status_column="status"))
     if len(results) == 1:  # the file is in the summary line; keep the table narrow
         for table in tables:

@@ -24,7 +24,7 @@ from pathlib import Path
 
 from ar3cli.errors import UserError
 from ar3cli.fix.continuous_plan import YamlLimits
-from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
+from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
 from ar3cli.fix.edits import Document
 
 INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
@@ -186,17 +186,10 @@ def _fill_effort_velocity(document: Document, plan: FixPlan, joint, options: Joi
 def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; each changed joint's limits, effort, velocity and axis as
     getJointInfo reports them must be the new values."""
-    from ar3cli.sim.session import run_pybullet
-
     joints = plan.context.get("joints", {})
     if not joints:
         return {"verified": True, "checks": []}
-    try:
-        checks = run_pybullet(lambda: _checks_in_pybullet(model, joints), model)
-    except UserError as exc:  # shown as a row too: the text output renders the checks only
-        message = exc.message.removeprefix(f"{model.path}: ")  # the path of the temporary file
-        return {"verified": False, "checks": [_check("(the file)", "loaded", False, message)], "error": message}
-    return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, joints))
 
 
 def _checks_in_pybullet(model, joints: dict) -> list[dict]:
@@ -209,24 +202,22 @@ def _checks_in_pybullet(model, joints: dict) -> list[dict]:
         for name, expected in joints.items():
             record = records.get(name)
             if record is None:
-                checks.append(_check(name, "loaded", False, "joint not found in pybullet"))
+                checks.append(check_row(name, "loaded", False, "joint not found in pybullet"))
                 continue
             info = session.p.getJointInfo(body.id, record.index, physicsClientId=session.client)
             if "lower" in expected:
                 ok = all(value is None or math.isclose(got, value, rel_tol=1e-9, abs_tol=1e-9)
                          for got, value in ((info[8], expected["lower"]), (info[9], expected["upper"])))
-                checks.append(_check(name, "limits", ok, f"getJointInfo lower={info[8]:.9g} upper={info[9]:.9g}"))
+                checks.append(check_row(name, "limits", ok, f"getJointInfo lower={info[8]:.9g} upper={info[9]:.9g}"))
             for key, index in (("effort", 10), ("velocity", 11)):
                 if key in expected:
-                    checks.append(_check(name, key, math.isclose(info[index], expected[key], rel_tol=1e-9),
+                    checks.append(check_row(name, key, math.isclose(info[index], expected[key], rel_tol=1e-9),
                                          f"getJointInfo {key}={info[index]:.9g}"))
             if "axis" in expected:
                 got = info[13]
                 ok = all(math.isclose(a, b, abs_tol=1e-9) for a, b in zip(got, expected["axis"]))
-                checks.append(_check(name, "unit axis", ok,
+                checks.append(check_row(name, "unit axis", ok,
                                      "getJointInfo axis=" + " ".join(f"{c:.9g}" for c in got)))
     return checks
 
 
-def _check(joint: str, check: str, ok: bool, detail: str) -> dict:
-    return {"joint": joint, "check": check, "status": "ok" if ok else "fail", "detail": detail}

@@ -23,7 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped
+from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, verified_in_pybullet
 from ar3cli.fix.edits import Document
 
 FILENAME_ELEMENTS = ("mesh", "texture")
@@ -177,17 +177,10 @@ def describe(element) -> str:
 def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; every rewritten visual/collision mesh must be loaded from the
     file its old URI pointed to (pybullet's getVisualShapeData / getCollisionShapeData)."""
-    from ar3cli.sim.session import run_pybullet
-
     meshes = [m for m in plan.context.get("meshes", []) if m["tag"] == "mesh" and m["link"] is not None]
     if not meshes:
         return {"verified": True, "checks": []}
-    try:
-        checks = run_pybullet(lambda: _checks_in_pybullet(model, meshes), model)
-    except UserError as exc:  # shown as a row too: the text output renders the checks only
-        message = exc.message.removeprefix(f"{model.path}: ")  # the path of the temporary file
-        return {"verified": False, "checks": [_check("(the file)", "loaded", False, message)], "error": message}
-    return {"verified": all(c["status"] == "ok" for c in checks), "checks": checks}
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, meshes))
 
 
 def _checks_in_pybullet(model, meshes: list[dict]) -> list[dict]:
@@ -206,13 +199,13 @@ def _checks_in_pybullet(model, meshes: list[dict]) -> list[dict]:
         checks: list[dict] = []
         for mesh in meshes:
             if mesh["link"] not in index:
-                checks.append(_check(mesh["element"], "mesh loaded", False, "link not found in pybullet"))
+                checks.append(check_row(mesh["element"], "mesh loaded", False, "link not found in pybullet"))
                 continue
             if mesh["file"] not in loaded.get((mesh["role"], index[mesh["link"]]), set()):
-                checks.append(_check(mesh["element"], "mesh loaded", False,
+                checks.append(check_row(mesh["element"], "mesh loaded", False,
                                      f"pybullet has no {mesh['role']} shape from {mesh['file']}"))
     count = len(meshes)
-    summary = _check("all rewritten meshes", "mesh loaded", True,
+    summary = check_row("all rewritten meshes", "mesh loaded", True,
                      f"{count} rewritten mesh URI(s): pybullet loaded each from the file the old URI named")
     return checks or [summary]
 
@@ -222,5 +215,3 @@ def _real(name: bytes) -> str:
     return str(Path(text).resolve()) if text else ""
 
 
-def _check(element: str, check: str, ok: bool, detail: str) -> dict:
-    return {"joint": element, "check": check, "status": "ok" if ok else "fail", "detail": detail}
