@@ -98,17 +98,12 @@ def measure(path: Path, scale: tuple[float, ...]) -> Measure:
     ``hull / mesh`` does not depend on the scale (a linear map multiplies both volumes by the same
     determinant); the volumes reported are scaled.
     """
-    import trimesh
-
-    from ar3cli.fix.geometry_mass import is_closed
+    from ar3cli.fix.geometry_mass import GeometryError, is_closed, load_welded_mesh
 
     try:
-        mesh = trimesh.load(str(path), force="mesh", process=True)
-    except Exception as exc:  # noqa: BLE001 - trimesh raises many types for unreadable files
-        raise MeshProblem(f"cannot read {path.name}: {exc}") from None
-    if mesh is None or len(getattr(mesh, "faces", ())) == 0:
-        raise MeshProblem(f"{path.name} has no triangles")
-    mesh.merge_vertices(merge_tex=True, merge_norm=True)  # OBJ splits vertices by normal / uv
+        mesh = load_welded_mesh(path)
+    except GeometryError as exc:
+        raise MeshProblem(str(exc).removeprefix("mesh ")) from None
     factor = scale_factor(scale)
     closed = bool(mesh.is_watertight or is_closed(mesh))
     mesh_volume = abs(float(mesh.volume)) * factor if closed else None

@@ -114,7 +114,9 @@ def mesh_mass(shape: Shape, cache: dict) -> tuple[mp.MassProperties, str]:
     return cache[key]
 
 
-def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float]) -> tuple[mp.MassProperties, str]:
+def load_welded_mesh(path: Path):
+    """The trimesh mesh of ``path`` with its vertices welded by position (OBJ files split them by
+    texture coordinate and normal); GeometryError when it cannot be read or has no triangle."""
     import trimesh
 
     try:
@@ -123,8 +125,12 @@ def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float]) -> tuple[
         raise GeometryError(f"mesh {path.name}: cannot read: {exc}") from None
     if mesh is None or len(getattr(mesh, "faces", ())) == 0:
         raise GeometryError(f"mesh {path.name} has no triangles")
-    # OBJ files split vertices by texture coordinate / normal: weld them by position only.
     mesh.merge_vertices(merge_tex=True, merge_norm=True)
+    return mesh
+
+
+def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float]) -> tuple[mp.MassProperties, str]:
+    mesh = load_welded_mesh(path)
     if tuple(scale) != (1.0, 1.0, 1.0):
         mesh.apply_transform(np.diag([*scale, 1.0]))
     scale_note = "" if tuple(scale) == (1.0, 1.0, 1.0) else f" scale {' '.join(_fmt(s) for s in scale)}"
