@@ -210,3 +210,35 @@ def test_render_frames_links_that_have_only_visual_geometry(cli, write_urdf, tmp
     pixels = Image.open(output).convert("RGB")
     assert len(pixels.getcolors(maxcolors=100_000)) > 10  # the sphere, shaded, fills the middle
     assert pixels.getpixel((32, 24)) != pixels.getpixel((0, 0))
+
+
+DRAKE = """<?xml version="1.0"?>
+<robot name="r">
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <collision><geometry><box size="0.1 0.1 0.1"/></geometry>
+      <drake:proximity_properties><drake:compliant_hydroelastic/></drake:proximity_properties></collision>
+    <visual><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+</robot>
+"""
+
+
+def test_an_undeclared_namespace_prefix_is_a_warning_and_the_file_works(cli, write_urdf, tmp_path):
+    """Drake's <drake:...> elements without xmlns:drake: PyBullet reads the file; lint warns (F005)."""
+    path = write_urdf(DRAKE)
+    data = json.loads(cli("lint-urdf", str(path), "--no-cache", "--format", "json").stdout)
+    (finding,) = [f for f in data["findings"] if f["rule"] in ("F002", "F005")]
+    assert finding["rule"] == "F005" and finding["line"] == 5 and "drake" in finding["message"]
+    assert cli("render", str(path), "-o", str(tmp_path / "d.png"), "--width", "64", "--height", "48").code == 0
+    assert path.read_text() == DRAKE  # only the parsed copy gets the declaration
+
+
+def test_a_urdf_that_is_really_xacro_says_so(cli, write_urdf, tmp_path):
+    path = write_urdf('<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">\n'
+                      '  <xacro:property name="l" value="0.1"/>\n'
+                      '  <link name="base"><visual><geometry><box size="${l} ${l} ${l}"/></geometry></visual></link>\n'
+                      '</robot>\n')
+    data = json.loads(cli("lint-urdf", str(path), "--no-cache", "--format", "json").stdout)
+    (f006,) = [f for f in data["findings"] if f["rule"] == "F006"]
+    assert "xacro source" in f006["hint"]
+    result = cli("render", str(path), "-o", str(tmp_path / "x.png"))
+    assert result.code == 2 and "is a xacro source" in result.stderr and not (tmp_path / "x.png").exists()

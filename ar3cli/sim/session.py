@@ -337,6 +337,9 @@ class Session:
         """
         p = self.p
         refuse_what_crashes_pybullet(model)
+        if model.looks_like_xacro:
+            raise UserError(f"{model.path}: is a xacro source (it declares the xacro namespace) with a .urdf name: "
+                            "rename it to .xacro, or expand it first (xacro FILE > robot.urdf)")
         if flags is None:
             flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_MAINTAIN_LINK_ORDER
         if self_collision == SELF_COLLISION_ALL_PAIRS:

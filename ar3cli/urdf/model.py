@@ -231,6 +231,12 @@ class Model:
                             "run ar3cli lint-urdf for details")
         return roots[0]
 
+    @cached_property
+    def looks_like_xacro(self) -> bool:
+        """A ``.urdf`` that is really a xacro source: it declares the xacro namespace and was not
+        expanded (xacro files themselves are expanded on load)."""
+        return not self.is_xacro and any("xacro" in (uri or "") for uri in self.root.nsmap.values())
+
     def movable_joints(self) -> list[Joint]:
         return [j for j in self.joints if j.moves]
 

@@ -106,6 +106,7 @@ def parse(data: bytes, path: Path):
         resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False, remove_blank_text=False
     )
     quirks: list[Quirk] = []
+    data = _declare_undeclared_prefixes(data, quirks)
     try:
         root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as exc:
@@ -120,6 +121,36 @@ def parse(data: bytes, path: Path):
     except ValueError as exc:  # e.g. unknown encoding declared
         raise UserError(f"{path}: cannot decode: {exc}") from None
     return root, quirks
+
+
+_PREFIXED_TAG = re.compile(rb"<([A-Za-z_][\w.-]*):[A-Za-z_]")
+_DECLARED = re.compile(rb"""xmlns:([A-Za-z_][\w.-]*)\s*=""")
+_ROOT_TAG = re.compile(rb"<robot\b")
+UNDECLARED_NAMESPACE = "urn:ar3cli:undeclared:"
+"""Namespace given to a prefix the file uses without declaring it (``drake:``, ``gazebo:``)."""
+
+
+def _declare_undeclared_prefixes(data: bytes, quirks: list[Quirk]) -> bytes:
+    """Declare on ``<robot>`` the element prefixes the file uses without an ``xmlns:`` for them.
+
+    Drake's URDFs write ``<drake:proximity_properties>`` with no declaration: XML namespaces make
+    that "not well-formed", yet PyBullet and urdfdom read the file (they ignore namespaces). The
+    prefix is declared in the parsed copy only (quirk ``undeclared-prefix``, lint's F005 warns);
+    the source bytes and every line number stay as they are.
+    """
+    used = set(_PREFIXED_TAG.findall(data)) - {b"xml", b"xmlns"}
+    missing = sorted(used - set(_DECLARED.findall(data)))
+    root = _ROOT_TAG.search(data)
+    if not missing or root is None:
+        return data
+    names = ", ".join(prefix.decode("ascii", "replace") for prefix in missing)
+    line = data.count(b"\n", 0, data.find(b"<" + missing[0] + b":")) + 1
+    quirks.append(Quirk("undeclared-prefix", f"namespace prefix {names} is used but never declared (xmlns:...): "
+                                             "PyBullet and urdfdom read the file, namespace-aware XML tools "
+                                             "(lxml, ROS 2 launch, xacro) refuse it", line))
+    declarations = b"".join(b" xmlns:" + prefix + b'="' + UNDECLARED_NAMESPACE.encode() + prefix + b'"'
+                            for prefix in missing)
+    return data[:root.end()] + declarations + data[root.end():]
 
 
 def _end_of_root(data: bytes, exc) -> int | None:

@@ -42,21 +42,24 @@ xacro_failed = engine_rule(
     good='<?xml version="1.0"?>\n<robot xmlns:xacro="http://www.ros.org/wiki/xacro" name="r">\n'
          '  <xacro:property name="prefix" value="my_"/>\n  <link name="${prefix}base"/>\n</robot>')
 
-_PORTABILITY_QUIRKS = ("version-", "leading-junk", "trailing-junk")
+_PORTABILITY_QUIRKS = ("version-", "leading-junk", "trailing-junk", "undeclared-prefix")
 
 
 @rule("F005", "strict-parser", "warning", "File needs a tolerant XML parser",
       why="""Strict parsers (urdfdom's TinyXML2, Python's xml.etree, ROS tools) reject
       version="0.0" declarations, blank lines or junk before the declaration, and bytes after the
-      root element. PyBullet and ar3cli tolerate them, so such files work in one tool and fail in
-      the next.""",
+      root element; namespace-aware ones (lxml, ROS 2 launch, xacro) reject an element prefix that
+      is never declared (Drake's <drake:...> elements without xmlns:drake). PyBullet and ar3cli
+      tolerate them, so such files work in one tool and fail in the next.""",
       fix='Write <?xml version="1.0"?> on the very first line and nothing after </robot>.',
       bad='<?xml version="0.0"?>\n<robot name="r">\n  <link name="base"/>\n</robot>\n',
       good=robot('<link name="base"/>'))
 def strict_parser(ctx) -> Iterator[Hit]:
     for quirk in ctx.model.quirks:
         if quirk.code.startswith(_PORTABILITY_QUIRKS):
-            yield Hit(quirk.message, line=quirk.line)
+            hint = ('Declare the prefix on <robot>, e.g. xmlns:drake="http://drake.mit.edu" for Drake\'s elements.'
+                    if quirk.code == "undeclared-prefix" else None)
+            yield Hit(quirk.message, line=quirk.line, hint=hint)
 
 
 _SUBSTITUTION = re.compile(r"\$\(|\$\{")
@@ -72,12 +75,18 @@ _SUBSTITUTION = re.compile(r"\$\(|\$\{")
 def unexpanded_substitution(ctx) -> Iterator[Hit]:
     if b"$" not in ctx.model.xml_bytes and b"&#" not in ctx.model.xml_bytes:
         return  # no "$" can reach an attribute (entities are refused): skip the walk over every attribute
+    xacro_source = ctx.model.looks_like_xacro
     for element in ctx.model.root.iter():
         if not isinstance(element.tag, str):
             continue
         for key, value in element.attrib.items():
             if _SUBSTITUTION.search(value):
-                yield Hit(f"<{element.tag} {key}=\"{value}\"> contains an unexpanded substitution", element)
+                yield Hit(f"<{element.tag} {key}=\"{value}\"> contains an unexpanded substitution", element,
+                          hint=XACRO_SOURCE_HINT if xacro_source else None)
+
+
+XACRO_SOURCE_HINT = ("This file is a xacro source (it declares the xacro namespace): rename it to .xacro (or "
+                     ".urdf.xacro) and run ar3cli on it, or expand it: xacro FILE > robot.urdf.")
 
 
 NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
