@@ -13,6 +13,7 @@ from lxml import etree
 from ar3cli.collisions import srdf as srdf_files
 from ar3cli.collisions.matrix import PairResult
 from ar3cli.fix.edits import Document
+from ar3cli.urdf.srdf import GENERATED_REASONS, read_srdf
 from tests.conftest import ASSETS, REPO
 
 FIXTURE = REPO / "tests" / "data" / "srdf" / "ar3.srdf"
@@ -65,7 +66,7 @@ def test_merge_keeps_hand_written_parts_byte_for_byte_and_is_idempotent(cli, tmp
     hand = {frozenset(("finger_left", "finger_right")), frozenset(("link_2", "link_4")),
             frozenset(("base_link", "link_3"))}
     got = entries(merged)
-    generated = {key for key, reason in got.items() if reason in srdf_files.GENERATED_REASONS}
+    generated = {key for key, reason in got.items() if reason in GENERATED_REASONS}
     assert generated == disabled - hand
     assert frozenset(("link_4", "link_6")) not in generated  # stale 'Never': sampling saw contact
     assert frozenset(("base_link", "camera_link")) not in got  # stale, and not a link of this URDF
@@ -158,7 +159,7 @@ SAMPLED = results(("b", "a", "adjacent"), ("a", "c", "never"), ("b", "c", "somet
 def merged(text: bytes, tmp_path: Path, sampled=SAMPLED, comment: str = "") -> bytes:
     path = tmp_path / "in.srdf"
     path.write_bytes(text)
-    existing = srdf_files.read_srdf(path)
+    existing = read_srdf(path)
     return srdf_files.merge(existing, Document(existing.data), sampled, comment).data
 
 
@@ -198,7 +199,7 @@ def test_moveit_semantics_of_enable_and_default_entries(tmp_path):
     path.write_text('<robot name="r"><disable_default_collisions link="a"/>'
                     '<enable_collisions link1="a" link2="b"/><disable_collisions link1="c" link2="d"/>'
                     '<enable_collisions link1="d" link2="c"/></robot>')
-    existing = srdf_files.read_srdf(path)
+    existing = read_srdf(path)
     assert existing.disabled_by("a", "c") == "default off"  # a's default entry
     assert existing.disabled_by("b", "a") is None  # the explicit enable beats the default
     assert existing.disabled_by("c", "d") == "disabled"  # an explicit disable wins, as in MoveIt
@@ -215,3 +216,21 @@ def test_real_panda_srdf_merge_keeps_everything(cli, tmp_path):
     assert result.code == 0, result.stderr
     assert hand_written_text(out.read_bytes()) == hand_written_text(source.read_bytes())
     assert json.loads(result.stdout)["srdf_compare"]["counts"]["unknown"] == 0
+
+
+def test_lint_sim_leaves_out_pairs_the_srdf_disables(cli, pybullet_data_dir, tmp_path):
+    """Issue 18 item 7: with --srdf, P002 does not report pairs the user already told MoveIt to skip."""
+    panda = str(pybullet_data_dir / "franka_panda" / "panda.urdf")
+    srdf = tmp_path / "panda.srdf"
+    srdf.write_text('<?xml version="1.0"?>\n<robot name="panda">\n'
+                    '  <disable_collisions link1="panda_link5" link2="panda_hand" reason="User"/>\n</robot>\n')
+
+    def pairs(*extra):
+        data = json.loads(cli("lint-urdf", "--sim", "--no-cache", "--select", "P002", panda, "--format", "json",
+                              *extra).stdout)
+        return {f["message"].split(" interpenetrate")[0] for f in data["findings"]}
+
+    assert "links 'panda_link5' and 'panda_hand'" in pairs()
+    assert "links 'panda_link5' and 'panda_hand'" not in pairs("--srdf", str(srdf))
+    refused = cli("lint-urdf", panda, "--srdf", str(srdf))
+    assert refused.code == 2 and "--srdf only changes the --sim checks" in refused.stderr

@@ -86,6 +86,10 @@ def lint_urdf(
                                                         "exit; takes no PATH.", show_default=False)] = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    srdf: Annotated[Optional[Path], typer.Option(
+        "--srdf", metavar="FILE.srdf", dir_okay=False,
+        help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
+    = None,
 ) -> None:
     """Check URDF and xacro files for mistakes that break ROS tools or make PyBullet misbehave.
 
@@ -114,7 +118,8 @@ def lint_urdf(
             select=(validate_patterns(_split(select), "--select") if select else config.select) or ["ALL"],
             ignore=[*config.ignore, *validate_patterns(_split(ignore), "--ignore")],
             per_file_ignores=config.per_file_ignores, severity=config.severity, sim=sim,
-            package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
+            package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg),
+            srdf_disabled=_srdf_disabled(srdf, sim))
     except ValueError as exc:
         raise UserError(str(exc)) from None
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
@@ -167,6 +172,17 @@ def lint_urdf(
     report.ok = report.ok or exit_zero
     report.errors = [*report.errors, *(result.error for result in results if result.error)]
     finish(report, "json" if fmt in (LintFormat.json, LintFormat.sarif) else "text")
+
+
+def _srdf_disabled(srdf: Path | None, sim: bool) -> frozenset[frozenset[str]]:
+    """The pairs ``--srdf`` disables; it only matters with ``--sim`` (a one-line error without)."""
+    if srdf is None:
+        return frozenset()
+    if not sim:
+        raise UserError("--srdf only changes the --sim checks (P002, contact at the home pose): add --sim")
+    from ar3cli.urdf.srdf import disabled_pairs
+
+    return disabled_pairs(srdf)
 
 
 def _write_baseline(path: Path, results, fmt: LintFormat) -> None:

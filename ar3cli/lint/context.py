@@ -12,8 +12,10 @@ class Context:
     """The model a rule checks, with the link boxes and the PyBullet session built once per file
     and shared by every rule that asks (pybullet is imported only when a ``--sim`` rule does)."""
 
-    def __init__(self, model: Model) -> None:
+    def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset()) -> None:
         self.model = model
+        self.srdf_disabled = srdf_disabled
+        """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf.is_disabled`)."""
         self._bounds: dict[str, Box | None] = {}
         self._session: Any = None
 

@@ -45,6 +45,8 @@ class LintOptions:
     sim: bool = False
     package_paths: Mapping[str, Path] = field(default_factory=dict)
     xacro_args: Mapping[str, str] = field(default_factory=dict)
+    srdf_disabled: frozenset[frozenset[str]] = frozenset()
+    """Link pairs an SRDF tells MoveIt not to check (``--srdf``): not reported as colliding at home."""
 
     def rules(self) -> list[Rule]:
         """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
@@ -210,7 +212,7 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
     """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
-    context = Context(model)
+    context = Context(model, options.srdf_disabled)
     locator = Locator(model, shown)
     file_ignores = _file_level_ignores(model.source_bytes)
     findings: list[Finding] = []

@@ -338,7 +338,7 @@ class Session:
         p = self.p
         refuse_what_crashes_pybullet(model)
         if model.looks_like_xacro:
-            raise UserError(f"{model.path}: is a xacro source (it declares the xacro namespace) with a .urdf name: "
+            raise UserError(f"{model.path}: is a xacro source (it holds <xacro:...> elements) with a .urdf name: "
                             "rename it to .xacro, or expand it first (xacro FILE > robot.urdf)")
         if flags is None:
             flags = p.URDF_USE_INERTIA_FROM_FILE | p.URDF_MAINTAIN_LINK_ORDER

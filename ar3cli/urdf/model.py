@@ -233,9 +233,13 @@ class Model:
 
     @cached_property
     def looks_like_xacro(self) -> bool:
-        """A ``.urdf`` that is really a xacro source: it declares the xacro namespace and was not
-        expanded (xacro files themselves are expanded on load)."""
-        return not self.is_xacro and any("xacro" in (uri or "") for uri in self.root.nsmap.values())
+        """A ``.urdf`` that is really an unexpanded xacro source: it holds ``<xacro:...>`` elements.
+        (Declaring the xacro namespace alone says nothing: xacro keeps the declaration in the URDF
+        it writes, as in example-robot-data's panda.urdf.) ``.xacro`` files are expanded on load."""
+        if self.is_xacro or b"xacro" not in self.xml_bytes:
+            return False
+        return any(isinstance(element.tag, str) and element.tag.startswith("{") and "xacro" in element.tag.split("}")[0]
+                   for element in self.root.iter())
 
     def movable_joints(self) -> list[Joint]:
         return [j for j in self.joints if j.moves]

@@ -85,7 +85,7 @@ def unexpanded_substitution(ctx) -> Iterator[Hit]:
                           hint=XACRO_SOURCE_HINT if xacro_source else None)
 
 
-XACRO_SOURCE_HINT = ("This file is a xacro source (it declares the xacro namespace): rename it to .xacro (or "
+XACRO_SOURCE_HINT = ("This file is a xacro source (it holds <xacro:...> elements): rename it to .xacro (or "
                      ".urdf.xacro) and run ar3cli on it, or expand it: xacro FILE > robot.urdf.")
 
 

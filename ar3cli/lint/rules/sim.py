@@ -82,12 +82,15 @@ def _stacked_boxes(tip_z: float) -> str:
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import nonadjacent_collisions
+    from ar3cli.urdf.srdf import is_disabled
 
     with _loaded(ctx, self_collision="all-pairs") as body:
         if body is None:
             return
         body.set_positions(_home(body))
         for a, b, depth in nonadjacent_collisions(body):
+            if is_disabled(ctx.srdf_disabled, a, b):
+                continue  # the user's SRDF tells MoveIt not to check this pair
             link = ctx.model.link(b) or ctx.model.link(a)
             yield Hit(f"links '{a}' and '{b}' interpenetrate by {_depth_text(-depth)} at the home pose",
                       link.element if link else None)

@@ -1,0 +1,134 @@
+"""Reading a MoveIt SRDF: its ``<disable_collisions>``/``<enable_collisions>`` entries and
+``<disable_default_collisions>``, safely (no entities, no DTD, no network), with one-line errors.
+
+Used by ``sample-collisions --srdf-merge/--srdf-compare`` (``ar3cli.collisions.srdf``) and by
+``lint-urdf --sim --srdf`` (pairs the user disabled are not reported as colliding at home).
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from ar3cli.errors import UserError
+
+GENERATED_REASONS = frozenset({"Adjacent", "Default", "Always", "Never"})
+"""Reasons MoveIt Setup Assistant (and ar3cli) write, exactly so spelt (``compute_default_collisions.cpp``);
+entries with any other reason, or none, are the user's."""
+
+
+@dataclass(frozen=True)
+class Entry:
+    """One ``<disable_collisions>`` or ``<enable_collisions>`` child of ``<robot>``."""
+
+    kind: str  # "disable" | "enable"
+    link1: str
+    link2: str
+    reason: str | None
+    line: int
+
+    @property
+    def key(self) -> frozenset[str]:
+        return frozenset((self.link1, self.link2))
+
+    @property
+    def generated(self) -> bool:
+        return self.kind == "disable" and self.reason in GENERATED_REASONS
+
+    @property
+    def label(self) -> str:
+        """How the SRDF treats the pair: its reason, ``disabled`` without one, or ``enabled``."""
+        if self.kind == "enable":
+            return "enabled"
+        return self.reason if self.reason else "disabled"
+
+
+@dataclass
+class Srdf:
+    """A parsed SRDF: its bytes, the lxml root, the collision entries (document order)."""
+
+    path: Path
+    data: bytes
+    root: Any
+    entries: list[Entry] = field(default_factory=list)
+    no_default: dict[str, int] = field(default_factory=dict)
+    """``<disable_default_collisions link=...>``: link -> line (every pair with it is disabled unless enabled)."""
+
+    @property
+    def robot_name(self) -> str | None:
+        return self.root.get("name")
+
+    def disabled_by(self, a: str, b: str) -> str | None:
+        """Why the SRDF disables the pair (its reason), or None when MoveIt checks it. As MoveIt builds
+        the allowed-collision matrix: an explicit disable wins, then an explicit enable, then the
+        links' default entries."""
+        key = frozenset((a, b))
+        explicit = [e for e in self.entries if e.key == key]
+        disabling = next((e for e in explicit if e.kind == "disable"), None)
+        if disabling is not None:
+            return disabling.label
+        if explicit:
+            return None
+        if a in self.no_default or b in self.no_default:
+            return "default off"
+        return None
+
+    @property
+    def hand_written(self) -> list[Entry]:
+        return [e for e in self.entries if not e.generated]
+
+
+def read_srdf(path: Path) -> Srdf:
+    """Read and parse an SRDF safely (no entities, no DTD, no network); one-line UserError otherwise."""
+    from lxml import etree
+
+    from ar3cli.infra.safe_read import read_bytes
+    from ar3cli.urdf.xmlsource import refuse_entities
+
+    if path.is_dir():
+        raise UserError(f"{path}: is a directory, expected an .srdf file")
+    if not path.exists():
+        raise UserError(f"{path}: no such file (an existing SRDF was expected)")
+    data = read_bytes(path)
+    refuse_entities(data, path)
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
+                             remove_blank_text=False)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        message = re.sub(r",? line \d+, column \d+.*$", "", str(exc.msg if hasattr(exc, "msg") else exc))
+        where = f"{path}:{exc.lineno}" if exc.lineno else str(path)
+        raise UserError(f"{where}: not well-formed XML: {message}") from None
+    except ValueError as exc:
+        raise UserError(f"{path}: cannot decode: {exc}") from None
+    if root.tag != "robot":
+        raise UserError(f"{path}:{root.sourceline}: the root element is <{root.tag}>, an SRDF has <robot>")
+    srdf = Srdf(path, data, root)
+    for element in root:
+        if element.tag in ("disable_collisions", "enable_collisions"):
+            link1, link2 = element.get("link1"), element.get("link2")
+            if not link1 or not link2:
+                raise UserError(f"{path}:{element.sourceline}: <{element.tag}> needs link1 and link2")
+            srdf.entries.append(Entry(element.tag.split("_")[0], link1, link2, element.get("reason"),
+                                      element.sourceline or 0))
+        elif element.tag == "disable_default_collisions" and element.get("link"):
+            srdf.no_default.setdefault(element.get("link"), element.sourceline or 0)
+    return srdf
+
+
+def disabled_pairs(path: Path) -> frozenset[frozenset[str]]:
+    """Every link pair the SRDF at ``path`` tells MoveIt not to check (explicit disables, and pairs
+    with a ``disable_default_collisions`` link that no ``enable_collisions`` turns back on), as
+    MoveIt reads it. Default-off links make every pair with them disabled: returned as ``{link}``
+    sets of one, which callers test with :func:`is_disabled`."""
+    srdf = read_srdf(path)
+    pairs = {entry.key for entry in srdf.entries if entry.kind == "disable"}
+    pairs |= {frozenset((link,)) for link in srdf.no_default}
+    return frozenset(pairs)
+
+
+def is_disabled(pairs: frozenset[frozenset[str]], a: str, b: str) -> bool:
+    """Whether ``disabled_pairs`` covers the pair (a, b)."""
+    return frozenset((a, b)) in pairs or frozenset((a,)) in pairs or frozenset((b,)) in pairs
