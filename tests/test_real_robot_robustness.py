@@ -242,3 +242,12 @@ def test_a_urdf_that_is_really_xacro_says_so(cli, write_urdf, tmp_path):
     assert "xacro source" in f006["hint"]
     result = cli("render", str(path), "-o", str(tmp_path / "x.png"))
     assert result.code == 2 and "is a xacro source" in result.stderr and not (tmp_path / "x.png").exists()
+
+
+def test_pybullet_chatter_in_a_child_never_reaches_stdout(cli, write_urdf):
+    """Romeo (example-robot-data): calculateInverseDynamics printed a b3Warning per non-unit axis on
+    C stdout, in the middle of info's JSON."""
+    text = (DATA / "in_order.urdf").read_text(encoding="utf-8").replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 2"/>')
+    result = cli("info", str(write_urdf(text)), "--torques", "--samples", "3", "--format", "json")
+    assert result.code == 0, result.stderr
+    assert json.loads(result.stdout)["torques"]

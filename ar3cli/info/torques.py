@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ar3cli.errors import UserError
+from ar3cli.sim.capture import capture_fds
 from ar3cli.urdf.model import Model
 
 GRAVITY = -9.81
@@ -167,13 +168,14 @@ def _compute(model: Model, samples: int, seed: int) -> _Needed:
         configurations = np.asarray(rows, dtype=float)
         zeros = [0.0] * len(joints)
         torques = np.empty_like(configurations)
-        for k, q in enumerate(configurations):
-            try:
-                tau = p.calculateInverseDynamics(body.id, [float(v) for v in q], zeros, zeros,
-                                                 physicsClientId=client)
-            except p.error as exc:
-                raise UserError(f"{model.path}: pybullet's inverse dynamics failed ({exc})") from None
-            torques[k] = tau
+        with capture_fds():  # pybullet's inverse dynamics prints a b3Warning per non-unit axis, per call
+            for k, q in enumerate(configurations):
+                try:
+                    tau = p.calculateInverseDynamics(body.id, [float(v) for v in q], zeros, zeros,
+                                                     physicsClientId=client)
+                except p.error as exc:
+                    raise UserError(f"{model.path}: pybullet's inverse dynamics failed ({exc})") from None
+                torques[k] = tau
         magnitude = np.abs(torques)
         needed = magnitude.max(axis=0)
         needed[needed < NEGLIGIBLE] = 0.0

@@ -107,6 +107,8 @@ def _run_child(work: Callable[[], Result], folder: str, pipe: BinaryIO) -> None:
     import faulthandler
 
     faulthandler.disable()  # a crash is reported by the parent in one line, not as a stack dump
+    sys.stdout.flush()
+    os.dup2(2, 1)  # stdout is the parent's (it may carry JSON): whatever the child prints goes to stderr
     tempfile.tempdir = folder
     _stage_pipe = pipe
     try:
