@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -11,7 +13,10 @@ from pathlib import Path
 
 import pytest
 
-os.environ.setdefault("AR3CLI_CACHE_DIR", tempfile.mkdtemp(prefix="ar3cli-test-cache-"))
+if "AR3CLI_CACHE_DIR" not in os.environ:
+    _TEST_CACHE = tempfile.mkdtemp(prefix="ar3cli-test-cache-")
+    os.environ["AR3CLI_CACHE_DIR"] = _TEST_CACHE
+    atexit.register(shutil.rmtree, _TEST_CACHE, ignore_errors=True)  # no folder outlives the test run
 """Tests (and the CLI processes they start) never write to the user's ~/.cache."""
 
 REPO = Path(__file__).resolve().parents[1]
