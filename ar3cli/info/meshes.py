@@ -2,25 +2,19 @@
 where a file says so cheaply.
 
 Only binary STL files are counted: their 84-byte header holds the triangle count (checked
-against the file size, the test :mod:`ar3cli.urdf.meshinfo` uses too). Counting OBJ, ASCII STL or
+against the file size by :func:`ar3cli.urdf.meshinfo.mesh_content`). Counting OBJ, ASCII STL or
 COLLADA triangles means reading and parsing each file (COLLADA needs trimesh, ~0.5 s to import):
 their count is left out, and the report says so, so ``info`` stays fast on big robots.
 """
 
 from __future__ import annotations
 
-import os
-import struct
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from ar3cli.urdf.meshinfo import is_lfs_pointer
+from ar3cli.urdf.meshinfo import is_lfs_pointer, mesh_content
 from ar3cli.urdf.model import Model
-
-STL_HEADER_BYTES = 84
-STL_RECORD_BYTES = 50
-"""A binary STL: 80-byte header, uint32 triangle count, then 50 bytes per triangle."""
 
 
 @dataclass
@@ -51,22 +45,11 @@ class MeshFacts:
 
 
 def binary_stl_triangles(path: Path) -> int | None:
-    """The triangle count in a binary STL's header, or None (not STL, ASCII STL, unreadable).
-
-    Reads 84 bytes and the file size, never the triangles.
-    """
-    if path.suffix.lower() != ".stl":
-        return None
-    try:
-        size = os.stat(path).st_size
-        with path.open("rb") as handle:
-            header = handle.read(STL_HEADER_BYTES)
-    except OSError:
-        return None
-    if len(header) < STL_HEADER_BYTES:
-        return None
-    (count,) = struct.unpack_from("<I", header, 80)
-    return count if size == STL_HEADER_BYTES + STL_RECORD_BYTES * count else None
+    """The triangle count in a binary STL's header, or None (not STL, ASCII STL, unreadable):
+    :func:`ar3cli.urdf.meshinfo.mesh_content` reads 84 bytes and the file size (cached on disk with
+    lint's mesh facts), never the triangles."""
+    content = mesh_content(path)
+    return content[1] if content is not None and content[0] == "stl-binary" else None
 
 
 def mesh_facts(model: Model) -> MeshFacts:
