@@ -157,10 +157,8 @@ def count_collisions(checker: Checker, configs: np.ndarray, jobs: int | None = N
     """
     from ar3cli.infra.process_pool import map_in_processes, worker_count
 
-    chunks = chunk_bounds(len(configs), jobs or 1)
     workers = worker_count(jobs, len(configs), SAMPLES_PER_WORKER)
-    if workers > 1:
-        chunks = chunk_bounds(len(configs), workers)
+    chunks = chunk_bounds(len(configs), workers)
     parent = os.getpid()
     tick = progress or (lambda done: None)
 
