@@ -63,6 +63,31 @@ def direct_parent_child(model: Model) -> set[frozenset[str]]:
     return {frozenset((j.parent, j.child)) for j in model.joints if j.parent and j.child}
 
 
+def rigid_groups(model: Model, moving: Iterable[str]) -> dict[str, str]:
+    """Each link's rigid group: links joined only by joints not in ``moving`` share one.
+
+    Two links of a group keep the same relative pose whatever the moving joints do, so a
+    self-collision test between them has the same answer in every configuration. Returns
+    link name -> the group's first link in file order.
+    """
+    moving = set(moving)
+    order = {link.name: index for index, link in enumerate(model.links)}
+    group = {name: name for name in order}
+
+    def root(name: str) -> str:
+        while group[name] != name:
+            group[name] = group[group[name]]
+            name = group[name]
+        return name
+
+    for joint in model.joints:
+        if joint.name not in moving and joint.parent in group and joint.child in group:
+            a, b = root(joint.parent), root(joint.child)
+            first, second = sorted((a, b), key=order.__getitem__)
+            group[second] = first
+    return {name: root(name) for name in group}
+
+
 def nonadjacent_collisions(body: Any, model: Model | None = None) -> list[tuple[str, str, float]]:
     """Non-adjacent pairs penetrating deeper than the tolerance at the body's *current* pose.
 
