@@ -178,6 +178,13 @@ def file_facts(name: str, version: int, max_entries: int = MAX_ENTRIES) -> FileF
     return FileFacts(name, version, max_entries)
 
 
+def load_all() -> None:
+    """Read every cache this process has opened now, before forking workers: the children then
+    share the entries (copy-on-write) instead of each parsing the same files again."""
+    for facts in _OPEN.values():
+        facts._load()
+
+
 def take_learned() -> dict[str, dict[str, Any]]:
     """What this process's caches learnt since the last call (a worker's gift to its parent)."""
     learned = {name: {"version": facts.version, "max_entries": facts.max_entries, "entries": facts._learned}

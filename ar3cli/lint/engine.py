@@ -14,6 +14,7 @@ import fnmatch
 import functools
 import os
 import re
+from collections import Counter
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -21,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
-from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
+from ar3cli.infra.file_cache import cache_dir, load_all, merge_learned, take_learned
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
 
@@ -128,14 +129,18 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     workers = worker_count(jobs, len(files), SIM_FILES_PER_WORKER if options.sim else FILES_PER_WORKER)
     if workers <= 1:
         return [lint_file(path, rules, options, cache) for path in files]
-    # The first file is checked before forking: the imports and caches it loads are then shared.
-    first = lint_file(files[0], rules, options, cache)
+    # The on-disk caches are read before forking, so every process shares them (the mesh modules
+    # that own them are imported by then). Not a whole file: one slow file checked first
+    # (a1.urdf, 20 ms) held back every process.
+    import ar3cli.urdf.meshinfo  # noqa: F401 - opens the mesh caches, for load_all
+
+    load_all()
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
-    outcomes = map_in_processes(job, files[1:], workers, what="a lint worker")
+    outcomes = map_in_processes(job, files, workers, what="a lint worker")
     for _, learned in outcomes:
         merge_learned(learned)
-    return [first, *(result for result, _ in outcomes)]
+    return [result for result, _ in outcomes]
 
 
 def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions,
@@ -395,6 +400,7 @@ _VARIABLE = re.compile(r"""'[^']*'|"[^"]*"|[^\s'"]*[/\\][^\s'"]*|[-+]?(?:\d+\.?\
 _VARIABLES = re.compile(r"#(?:[\s,]+#)+")
 
 
+@functools.lru_cache(maxsize=4096)
 def message_shape(message: str) -> str:
     """``message`` with names, paths and numbers replaced by ``#`` (a run of them by one ``#``)."""
     return _VARIABLES.sub("#", _VARIABLE.sub("#", message))
@@ -429,9 +435,12 @@ def group_findings(findings: list[Finding], at_least: int = GROUP_AT) -> list[Fi
     same file, rule, severity and message and hint shapes (:func:`message_shape`) become one
     :class:`FindingGroup`, placed where the first of them was."""
     def key(finding: Finding) -> tuple:
-        return (finding.path, finding.rule, finding.severity, message_shape(finding.message),
-                message_shape(finding.hint))
+        plain = (finding.path, finding.rule, finding.severity)
+        if candidates[plain] < at_least:  # too few to group whatever their messages: no regex
+            return plain
+        return (*plain, message_shape(finding.message), message_shape(finding.hint))
 
+    candidates = Counter((finding.path, finding.rule, finding.severity) for finding in findings)
     keys = [key(finding) for finding in findings]
     members: dict[tuple, list[Finding]] = {}
     for finding, finding_key in zip(findings, keys):
