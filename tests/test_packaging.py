@@ -21,4 +21,4 @@ def test_wheel_contains_assets_and_console_script(tmp_path):
     for asset in ASSETS.rglob("*.urdf"):
         assert f"ar3cli/assets/{asset.relative_to(ASSETS).as_posix()}" in names
     entry_points = next(name for name in names if name.endswith("entry_points.txt"))
-    assert "ar3cli = ar3cli.cli:main" in zipfile.ZipFile(wheel).read(entry_points).decode()
+    assert "ar3cli = ar3cli.cli:run" in zipfile.ZipFile(wheel).read(entry_points).decode()
