@@ -41,6 +41,18 @@ def run_cli(*args: str, cwd: Path | None = None, env: dict[str, str] | None = No
     return CliResult(completed.returncode, completed.stdout, completed.stderr)
 
 
+def cache_files(folder: Path, name: str) -> list[Path]:
+    """The shard files of the on-disk cache ``name`` (e.g. ``lint-results-v1``) under ``folder``."""
+    return sorted((folder / name).glob("*.json"))
+
+
+def cache_entries(folder: Path, name: str) -> dict:
+    """Every entry of the on-disk cache ``name`` under ``folder``, all its shard files merged."""
+    import json
+
+    return {key: value for shard in cache_files(folder, name) for key, value in json.loads(shard.read_text()).items()}
+
+
 @pytest.fixture
 def cli():
     """The :func:`run_cli` helper as a fixture."""

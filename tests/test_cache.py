@@ -17,7 +17,7 @@ def folder(tmp_path, monkeypatch):
 
 
 def saved(folder) -> dict:
-    return json.loads((folder / "facts-v1.json").read_text())
+    return json.loads((folder / "facts-v1" / "common.json").read_text())
 
 
 def test_two_processes_saving_at_once_keep_both_their_entries(folder) -> None:
@@ -49,7 +49,35 @@ def test_trimming_keeps_the_most_recently_stored(folder) -> None:
 def test_a_store_that_is_not_a_regular_file_is_ignored(folder, tmp_path) -> None:
     import os
 
-    folder.mkdir()
-    os.mkfifo(folder / "facts-v1.json")
+    (folder / "facts-v1").mkdir(parents=True)
+    os.mkfifo(folder / "facts-v1" / "common.json")
     assert FileFacts("facts", 1).lookup("a") is MISSING  # returns at once, no writer needed
     assert path_state(str(tmp_path / "nothing")) is None
+
+
+def test_one_file_per_folder_and_a_run_reads_only_the_folders_it_asks_about(folder, tmp_path) -> None:
+    """Facts about files of two folders land in two shard files; a later run asking about one folder
+    parses that folder's file alone (with one store file, every run parsed every entry ever saved).
+    The single store file of earlier versions is removed."""
+    import os
+
+    from ar3cli.infra.file_cache import shard_of
+
+    (tmp_path / "a").mkdir()
+    (tmp_path / "b").mkdir()
+    first, second = tmp_path / "a" / "one.stl", tmp_path / "b" / "two.stl"
+    for mesh in (first, second):
+        mesh.write_bytes(b"solid")
+    folder.mkdir()
+    (folder / "facts-v1.json").write_text("{}")  # ar3cli 0.1's store
+    facts = FileFacts("facts", 1)
+    facts.put(first, os.stat(first), 1)
+    facts.put(second, os.stat(second), 2)
+    facts.save()
+    assert sorted(path.name for path in (folder / "facts-v1").glob("*.json")) == sorted(
+        f"{shard_of(mesh)}.json" for mesh in (first, second))
+    assert not (folder / "facts-v1.json").exists()
+    again = FileFacts("facts", 1)
+    assert again.get(first, os.stat(first)) == 1
+    assert list(again._shards) == [shard_of(first)]
+    assert shard_of(first) == shard_of(tmp_path / "a" / "other.stl") != shard_of(second)

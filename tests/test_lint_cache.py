@@ -9,10 +9,11 @@ from pathlib import Path
 import pytest
 
 from ar3cli.infra import file_cache as cache
-from ar3cli.infra.file_cache import FileFacts
+from ar3cli.infra.file_cache import FileFacts, shard_of
 from ar3cli.lint import result_cache as lint_cache
 from ar3cli.lint.engine import LintOptions, _result_cache, lint_paths
 from ar3cli.urdf import model
+from tests.conftest import cache_entries, cache_files
 
 MESH_ROBOT = """<?xml version="1.0"?>
 <robot name="r">
@@ -84,7 +85,7 @@ def test_an_edited_file_is_checked_again_and_replaces_its_entry(store, loads, wr
     write_urdf(MESH_ROBOT.format(uri="meshes/missing.stl").replace('name="r"', ""))
     assert {"G001", "S001"} <= codes(path)
     assert len(loads) == 2
-    assert len(lint_cache._STORE._load()) == 1  # a file edited a thousand times keeps one entry
+    assert sum(map(len, lint_cache._STORE._shards.values())) == 1  # a file edited a thousand times keeps one entry
 
 
 def test_a_mesh_that_appears_or_disappears_is_noticed(store, loads, write_urdf, tmp_path) -> None:
@@ -134,15 +135,15 @@ def test_xacro_sim_and_no_cache_are_never_answered_from_it(store, loads, write_u
     findings(urdf)
     findings(urdf)
     assert len(loads) == 6
-    assert not lint_cache._STORE._load()  # nothing was remembered
+    assert not any(lint_cache._STORE._shards.values())  # nothing was remembered
 
 
 def test_a_damaged_store_or_entry_means_checking_again(store, loads, write_urdf) -> None:
     path = write_urdf(MESH_ROBOT.format(uri="meshes/missing.stl"))
-    store.mkdir()
-    (store / "lint-results-v1.json").write_bytes(b"\x00not json")
+    (store / "lint-results-v1").mkdir(parents=True)
+    (store / "lint-results-v1" / f"{shard_of(path)}.json").write_bytes(b"\x00not json")
     expected = findings(path)
-    (entry,) = lint_cache._STORE._load().values()
+    (entry,) = [entry for shard in lint_cache._STORE._shards.values() for entry in shard.values()]
     entry["findings"] = [["G001", "fatal"]]
     assert findings(path) == expected
     assert len(loads) == 2
@@ -155,7 +156,7 @@ def test_results_persist_between_processes(cli, tmp_path, write_urdf) -> None:
     write_stl(tmp_path / "mypkg" / "meshes" / "part.stl", 0.1)
     env = {"AR3CLI_CACHE_DIR": str(tmp_path / "cache")}
     first = cli("lint-urdf", "-f", "json", "--no-config", str(path), env=env)
-    store = json.loads((tmp_path / "cache" / "lint-results-v1.json").read_text())
+    store = cache_entries(tmp_path / "cache", "lint-results-v1")
     second = cli("lint-urdf", "-f", "json", "--no-config", str(path), env=env)
     assert len(store) == 1 and second.stdout == first.stdout and first.stderr == second.stderr == ""
     assert {f["rule"] for f in json.loads(first.stdout)["findings"]} == set()  # the folder is named mypkg
@@ -229,8 +230,8 @@ def test_a_damaged_store_never_breaks_a_run(store, cli, write_urdf, damage, tmp_
     env = {"AR3CLI_CACHE_DIR": str(store)}
     clean = cli("lint-urdf", "--no-cache", "--no-config", "-f", "sarif", str(path), env=env)
     cli("lint-urdf", "--no-config", str(path), env=env)
-    results = store / "lint-results-v1.json"
-    meshes = store / "mesh-bounds-v2.json"
+    (results,) = cache_files(store, "lint-results-v1")
+    (meshes,) = cache_files(store, "mesh-bounds-v2")
     if damage == "nested":
         for target in (results, meshes):
             target.write_text("[" * 5000 + "]" * 5000)

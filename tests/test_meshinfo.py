@@ -88,7 +88,7 @@ def test_disk_cache_reuses_and_invalidates(tmp_path, monkeypatch):
 
     assert fresh_bounds() == ((0.0, 0.0, 0.0), (1.0, 2.0, 3.0))
     meshinfo._DISK_CACHE.save()
-    stored = next((tmp_path / "cache").glob("mesh-bounds-v2.json"))
+    stored = next((tmp_path / "cache" / "mesh-bounds-v2").glob("*.json"))
     import json
 
     entries = json.loads(stored.read_text())

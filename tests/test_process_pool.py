@@ -12,6 +12,7 @@ import pytest
 from ar3cli.errors import UserError
 from ar3cli.infra import process_pool
 from ar3cli.infra.process_pool import map_in_processes, worker_count
+from tests.conftest import cache_entries
 
 pytestmark = pytest.mark.skipif(not process_pool.can_fork(), reason="forked workers are used on Linux only")
 several_cpus = pytest.mark.skipif(process_pool.available_cpus() < 2,
@@ -107,7 +108,7 @@ def test_lint_output_and_caches_do_not_depend_on_jobs(cli, tmp_path, pybullet_da
                      env={"AR3CLI_CACHE_DIR": str(cache)})
         assert result.code in (0, 1) and result.stderr == "", result.stderr
         outputs[jobs] = result.stdout
-        remembered = json.loads((cache / "lint-results-v1.json").read_text())
+        remembered = cache_entries(cache, "lint-results-v1")
         loaded = [f for f in json.loads(result.stdout)["files"] if f["loaded"]]
         assert len(remembered) == len(loaded) > 20
     assert outputs[1] == outputs[3]
@@ -182,7 +183,7 @@ def test_facts_a_child_learnt_are_saved_even_if_this_process_never_needed_that_c
     result = cli("lint-urdf", "--no-config", "--select", "I007", "--jobs", "2", *map(str, models),
                  env={"AR3CLI_CACHE_DIR": str(cache)})
     assert result.code in (0, 1), result.stderr
-    boxes = json.loads((cache / "mesh-bounds-v2.json").read_text())
+    boxes = cache_entries(cache, "mesh-bounds-v2")
     assert any("kuka_iiwa" in key for key in boxes)
 
 

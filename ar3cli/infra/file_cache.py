@@ -3,10 +3,11 @@
 A pre-commit hook or a CI step lints the same meshes again and again; reading 50 MB of OBJ and
 STL text takes longer than all the rules together. Facts are keyed by the file's absolute path
 (not resolved through symlinks: realpath costs more than the lookup it serves), modification and
-status-change times (ns) and size, so an edited mesh is read again. The cache is one JSON file per
-kind of fact, written atomically at exit and only when something new was learnt, merged under a
-lock with what other ar3cli processes saved meanwhile (pre-commit runs several at once); a corrupt
-or unreadable cache is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
+status-change times (ns) and size, so an edited mesh is read again. Each kind of fact is a folder
+of JSON files, one per folder of the files the facts are about (a run reads only the ones it needs),
+written atomically at exit and only when something new was learnt, merged under a lock with what
+other ar3cli processes saved meanwhile (pre-commit runs several at once); a corrupt or unreadable
+file is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
 ``AR3CLI_CACHE_DIR`` moves it (default ``$XDG_CACHE_HOME/ar3cli`` or ``~/.cache/ar3cli``).
 
 A forked worker process (:mod:`ar3cli.infra.process_pool`) never saves: it hands what it learnt to its
@@ -19,6 +20,7 @@ import atexit
 import contextlib
 import json
 import os
+import zlib
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -46,6 +48,11 @@ def path_state(path: str) -> PathState | None:
 _OPEN: dict[str, FileFacts] = {}
 """This process's caches by name, for handing what a worker learnt to its parent."""
 
+COMMON_SHARD = "common"
+"""The shard of entries stored without a path to place them by."""
+MAX_SHARDS = 2_000
+"""Shard files kept per cache; beyond this the least recently written are removed when saving."""
+
 
 def cache_dir() -> Path | None:
     """Where caches live, or None when caching is turned off."""
@@ -57,87 +64,117 @@ def cache_dir() -> Path | None:
     return Path(base) / "ar3cli"
 
 
+def shard_of(near: str | os.PathLike[str] | None) -> str:
+    """The shard holding entries about ``near``: one per folder (a robot's meshes sit together)."""
+    if near is None:
+        return COMMON_SHARD
+    folder = os.path.dirname(os.path.abspath(near))
+    # a checksum, not a secure hash (hashlib costs an import): two folders sharing a shard only share a file
+    return f"{zlib.crc32(folder.encode('utf-8', 'surrogateescape')):08x}"
+
+
 class FileFacts:
-    """Facts (JSON values) about files, persisted in ``<cache dir>/<name>-v<version>.json``.
+    """Facts (JSON values) about files, persisted in ``<cache dir>/<name>-v<version>/<shard>.json``.
 
     Keys are built from a file's path and stat (:meth:`get` / :meth:`put`) or given whole by the
-    caller (:meth:`lookup` / :meth:`store`). At most ``max_entries`` are kept.
+    caller (:meth:`lookup` / :meth:`store`, placed by the file they are about: ``near``). Entries
+    are kept in one shard file per folder, and a run reads only the shards of the folders it asks
+    about: with one store file, every run parsed every entry ever saved (4,400 mesh boxes, 0.9 MB:
+    12 ms of each lint; 20,000: ~50 ms). At most ``max_entries`` are kept per shard.
     """
 
     def __init__(self, name: str, version: int, max_entries: int = MAX_ENTRIES) -> None:
         self.name = name
         self.version = version
         self.max_entries = max_entries
-        self._entries: dict[str, Any] | None = None
-        self._dirty = False
-        self._changed: dict[str, Any] = {}
-        """Entries stored or merged by this process: what :meth:`save` writes."""
-        self._learned: dict[str, Any] = {}
+        self._shards: dict[str, dict[str, Any]] = {}
+        self._changed: dict[str, dict[str, Any]] = {}
+        """Entries stored or merged by this process, by shard: what :meth:`save` writes."""
+        self._learned: dict[str, dict[str, Any]] = {}
         """Entries stored since :func:`take_learned` last asked (a worker's answer to its parent)."""
+        self._saving = False
         _OPEN[name] = self
 
     def _key(self, path: Path, status: os.stat_result) -> str:
         return f"{os.path.abspath(path)}|{status.st_mtime_ns}|{status.st_ctime_ns}|{status.st_size}"
 
-    def _file(self) -> Path | None:
+    def _folder(self) -> Path | None:
         folder = cache_dir()
-        return folder / f"{self.name}-v{self.version}.json" if folder else None
+        return folder / f"{self.name}-v{self.version}" if folder else None
 
-    def _load(self) -> dict[str, Any]:
-        if self._entries is None:
-            location = self._file()
-            self._entries = _read_entries(location) if location is not None else {}
-        return self._entries
+    def _load(self, shard: str) -> dict[str, Any]:
+        entries = self._shards.get(shard)
+        if entries is None:
+            folder = self._folder()
+            entries = self._shards[shard] = _read_entries(folder / f"{shard}.json") if folder is not None else {}
+        return entries
 
     def get(self, path: Path, status: os.stat_result) -> Any:
         """The stored fact for this version of ``path``, or :data:`MISSING`."""
-        return self.lookup(self._key(path, status))
+        return self.lookup(self._key(path, status), near=path)
 
     def put(self, path: Path, status: os.stat_result, value: Any) -> None:
         """Remember ``value`` (JSON-serialisable) for this version of ``path``; saved at exit."""
-        self.store(self._key(path, status), value)
+        self.store(self._key(path, status), value, near=path)
 
-    def lookup(self, key: str) -> Any:
-        """The value stored under ``key``, or :data:`MISSING`."""
-        return self._load().get(key, MISSING)
+    def lookup(self, key: str, near: str | os.PathLike[str] | None = None) -> Any:
+        """The value stored under ``key`` (in the shard of ``near``), or :data:`MISSING`."""
+        return self._load(shard_of(near)).get(key, MISSING)
 
-    def store(self, key: str, value: Any) -> None:
-        """Remember ``value`` (JSON-serialisable) under ``key``; saved at exit."""
-        self._learned[key] = value
-        self._merge({key: value})
+    def store(self, key: str, value: Any, near: str | os.PathLike[str] | None = None) -> None:
+        """Remember ``value`` (JSON-serialisable) under ``key``, in the shard of ``near``; saved at exit."""
+        shard = shard_of(near)
+        self._learned.setdefault(shard, {})[key] = value
+        self._merge(shard, {key: value})
 
-    def _merge(self, entries: dict[str, Any]) -> None:
-        loaded = self._load()
+    def _merge(self, shard: str, entries: dict[str, Any]) -> None:
+        loaded = self._load(shard)
         for key, value in entries.items():
             loaded.pop(key, None)  # stored again: it moves to the end, the newest
             loaded[key] = value
-        self._changed.update(entries)
-        if not self._dirty and self._file() is not None:
+        self._changed.setdefault(shard, {}).update(entries)
+        if not self._saving and self._folder() is not None:
             atexit.register(self.save)
-        self._dirty = True
+            self._saving = True
 
     def save(self) -> None:
-        """Write what this process stored into the cache file, atomically and under a lock, on top
-        of what is there now (other processes may have saved since this one read it); only the
-        newest :attr:`max_entries` are kept. Failures are silent (a cache is optional)."""
-        location = self._file()
-        if not self._dirty or location is None:
+        """Write what this process stored into its shard files, atomically and under a lock, on top
+        of what is there now (other processes may have saved since this one read them); only the
+        newest :attr:`max_entries` of a shard are kept, and the :data:`MAX_SHARDS` most recently
+        written shards. Failures are silent (a cache is optional)."""
+        folder = self._folder()
+        if not self._changed or folder is None:
             return
         try:
             from ar3cli.infra.atomic import atomic_write
 
-            location.parent.mkdir(parents=True, exist_ok=True)
-            with _locked(location.with_name(location.name + ".lock")):
-                entries = _read_entries(location)
-                for key, value in self._changed.items():
-                    entries.pop(key, None)
-                    entries[key] = value
-                if len(entries) > self.max_entries:
-                    entries = dict(list(entries.items())[-self.max_entries:])
-                atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"))
-            self._dirty = False
+            folder.mkdir(parents=True, exist_ok=True)
+            with _locked(folder / ".lock"):
+                for shard, changed in self._changed.items():
+                    location = folder / f"{shard}.json"
+                    entries = _read_entries(location)
+                    for key, value in changed.items():
+                        entries.pop(key, None)
+                        entries[key] = value
+                    if len(entries) > self.max_entries:
+                        entries = dict(list(entries.items())[-self.max_entries:])
+                    atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"))
+                _remove_oldest(folder, MAX_SHARDS)
+                legacy = folder.with_name(f"{folder.name}.json")  # ar3cli <= 0.1's one store file
+                legacy.unlink(missing_ok=True)
+                legacy.with_name(legacy.name + ".lock").unlink(missing_ok=True)
+            self._changed = {}
         except Exception:  # noqa: BLE001 - a read-only home must never break a lint
             pass
+
+
+def _remove_oldest(folder: Path, keep: int) -> None:
+    """Remove all but the ``keep`` most recently written shard files of ``folder``."""
+    shards = list(folder.glob("*.json"))
+    if len(shards) > keep:
+        shards.sort(key=lambda shard: shard.stat().st_mtime_ns)
+        for shard in shards[:-keep]:
+            shard.unlink(missing_ok=True)
 
 
 def _read_entries(location: Path) -> dict[str, Any]:
@@ -178,16 +215,9 @@ def file_facts(name: str, version: int, max_entries: int = MAX_ENTRIES) -> FileF
     return FileFacts(name, version, max_entries)
 
 
-def load_all() -> None:
-    """Read every cache this process has opened now, before forking workers: the children then
-    share the entries (copy-on-write) instead of each parsing the same files again."""
-    for facts in _OPEN.values():
-        facts._load()
-
-
 def take_learned() -> dict[str, dict[str, Any]]:
     """What this process's caches learnt since the last call (a worker's gift to its parent)."""
-    learned = {name: {"version": facts.version, "max_entries": facts.max_entries, "entries": facts._learned}
+    learned = {name: {"version": facts.version, "max_entries": facts.max_entries, "shards": facts._learned}
                for name, facts in _OPEN.items() if facts._learned}
     for facts in _OPEN.values():
         facts._learned = {}
@@ -197,4 +227,6 @@ def take_learned() -> dict[str, dict[str, Any]]:
 def merge_learned(learned: dict[str, dict[str, Any]]) -> None:
     """Add what a worker learnt (:func:`take_learned`) to this process's caches, saved at exit."""
     for name, gift in learned.items():
-        file_facts(name, gift["version"], gift["max_entries"])._merge(gift["entries"])
+        facts = file_facts(name, gift["version"], gift["max_entries"])
+        for shard, entries in gift["shards"].items():
+            facts._merge(shard, entries)

@@ -22,7 +22,7 @@ from typing import TYPE_CHECKING, Any
 
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
-from ar3cli.infra.file_cache import cache_dir, load_all, merge_learned, take_learned
+from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
 
@@ -129,12 +129,6 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     workers = worker_count(jobs, len(files), SIM_FILES_PER_WORKER if options.sim else FILES_PER_WORKER)
     if workers <= 1:
         return [lint_file(path, rules, options, cache) for path in files]
-    # The on-disk caches are read before forking, so every process shares them (the mesh modules
-    # that own them are imported by then). Not a whole file: one slow file checked first
-    # (a1.urdf, 20 ms) held back every process.
-    import ar3cli.urdf.meshinfo  # noqa: F401 - opens the mesh caches, for load_all
-
-    load_all()
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
     outcomes = map_in_processes(job, files, workers, what="a lint worker")
