@@ -17,6 +17,11 @@ configurations), classifies the pairs and prints the matrix; the notes say which
 sampled. Each script (and ar3cli's JSON) reports its own sampling-loop time, so the notes split
 process time into start-up and loop. CPU time includes every process ar3cli forks.
 
+After the timing, once (not timed): the **verdicts** of ar3cli's JSON against an independent all-pairs
+check of the same configurations (``VERIFY`` below: plain ``loadURDF``, one ``getClosestPoints`` query
+per configuration for every link pair, its own adjacency and classification); the notes say how many
+pairs got the same category and how many sampled pairs got a different count.
+
 Then the ``--jobs`` scaling rows: ``ar3cli sample-collisions ... --jobs 1`` vs ``--jobs 2`` (and
 ``--jobs 4`` when this machine has at least 4 usable cores) at ``--scaling-samples`` configurations.
 
@@ -82,6 +87,113 @@ loop = time.perf_counter() - start
 print(json.dumps({"samples": samples, "joints": len(joints), "pairs_in_contact": len(counts), "loop_s": loop}))
 '''
 
+
+VERIFY = r'''
+"""Independent all-pairs check of a sample-collisions matrix (run once, not timed).
+
+The configurations come from ar3cli's own sampler (the same seed gives the same rows: joint names,
+mimic joints and limits as ar3cli reads them). Everything else is done here without ar3cli: the
+URDF loaded by plain loadURDF with no self-collision flags, each configuration set with
+resetJointState and tested with ONE getClosestPoints(body, body, 5 mm) query (one-shot, every link
+pair, a link and its parent included, no contact manifolds), adjacency computed from pybullet's own
+joint tree (MoveIt's rule: links without collision shapes are looked through), and each pair
+classified adjacent > default > always > never > sometimes. Prints {"link_a|link_b": [category,
+count]} as JSON.
+"""
+import json, sys
+from pathlib import Path
+import pybullet as p
+from ar3cli.sim.sampling import joint_space, limit_configurations, sample_configurations
+from ar3cli.sim.session import Session
+from ar3cli.urdf.model import load_model
+
+path, samples, seed, threshold = Path(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4])
+with Session() as session:
+    space = joint_space(session.load(load_model(path)))
+configs = sample_configurations(space, samples, seed)
+limits = [q for label, q in limit_configurations(space) if label != "home"]
+
+p.connect(p.DIRECT)
+body = p.loadURDF(str(path), useFixedBase=True)
+count = p.getNumJoints(body)
+infos = [p.getJointInfo(body, i) for i in range(count)]
+name = {-1: p.getBodyInfo(body)[0].decode(), **{i: info[12].decode() for i, info in enumerate(infos)}}
+joint = {info[1].decode(): i for i, info in enumerate(infos)}
+columns = [joint[n] for n in space.names]
+solid = [i for i in range(-1, count) if p.getCollisionShapeData(body, i)]
+neighbours = {i: set() for i in range(-1, count)}
+for i, info in enumerate(infos):
+    neighbours[i].add(info[16]); neighbours[info[16]].add(i)
+adjacent = set()
+for start in solid:
+    seen, frontier = {start}, [start]
+    while frontier:
+        for other in neighbours[frontier.pop()] - seen:
+            seen.add(other)
+            if other in solid:
+                adjacent.add(frozenset((start, other)))
+            else:
+                frontier.append(other)
+
+def hits(q):
+    for index, value in zip(columns, q):
+        p.resetJointState(body, index, float(value))
+    deepest = {}
+    for point in p.getClosestPoints(body, body, 0.005):
+        if point[3] != point[4]:
+            key = frozenset((point[3], point[4]))
+            deepest[key] = min(deepest.get(key, 1.0), point[8])
+    return {key for key, depth in deepest.items() if depth < -1e-6}
+
+home = hits(space.home)
+at_limits = set().union(*(hits(q) for q in limits)) if limits else set()
+counts = {}
+for q in configs:
+    for key in hits(q):
+        counts[key] = counts.get(key, 0) + 1
+result = {}
+for k, a in enumerate(solid):
+    for b in solid[k + 1:]:
+        key = frozenset((a, b))
+        n = counts.get(key, 0)
+        if key in adjacent:
+            category = "adjacent"
+        elif key in home:
+            category = "default"
+        elif n / samples >= threshold:
+            category = "always"
+        elif n == 0 and key not in at_limits:
+            category = "never"
+        else:
+            category = "sometimes"
+        result["|".join(sorted((name[a], name[b])))] = [category, n]
+print(json.dumps(result))
+'''
+
+
+def verdicts(robot: Path, samples: int, document: dict) -> str:
+    """Compare ar3cli's categories (its JSON) with :data:`VERIFY`'s independent all-pairs check."""
+    import subprocess
+    import time
+
+    script = _timing.write_script("verify_matrix.py", VERIFY)
+    start = time.perf_counter()
+    done = subprocess.run([sys.executable, str(script), str(robot), str(samples), str(SEED),
+                           str(document.get("always_threshold", 0.95))], capture_output=True, text=True)
+    if done.returncode != 0:
+        return f"independent all-pairs check failed: {done.stderr.strip()[-500:]}"
+    theirs = json.loads(done.stdout.strip().splitlines()[-1])
+    ours = {"|".join(sorted((pair["link_a"], pair["link_b"]))): pair for pair in document["pairs"]}
+    differing = [f"{key}: ar3cli {ours[key]['category']} ({ours[key]['collisions']}), independent "
+                 f"{theirs[key][0]} ({theirs[key][1]})" for key in sorted(theirs)
+                 if key not in ours or ours[key]["category"] != theirs[key][0]]
+    count_differs = sum(1 for key, pair in ours.items() if pair.get("sampled", True)
+                           and key in theirs and pair["collisions"] != theirs[key][1])
+    same = len(theirs) - len(differing)
+    return (f"**verdicts: {same} of {len(theirs)} pairs in the same category** as an independent all-pairs check "
+            f"(same {samples} configurations, one getClosestPoints query each, own adjacency; "
+            f"{time.perf_counter() - start:.0f} s); sampled pairs whose count differs: {count_differs}"
+            + (f"; differing: {'; '.join(differing[:5])}" if differing else ""))
 
 class Parsed:
     """Keeps the JSON each run of a variant printed (last line of stdout), for the notes."""
@@ -167,6 +279,7 @@ def compare_with_plain(ar3cli: list[str], robot: Path, script: Path, samples: in
         note_loop("plain script", variants[2], plain, "loop_s"),
         note_loop("tutorial loop", variants[3], tutorial, "loop_s"),
         describe(ours.documents[-1]),
+        verdicts(robot, samples, ours.documents[-1]),
         f"the plain scripts load with pybullet's default self-collision (URDF_USE_SELF_COLLISION: a link "
         f"and its direct parent are never checked) and found {plain.documents[-1]['pairs_in_contact']} "
         f"(plain) / {tutorial.documents[-1]['pairs_in_contact']} (tutorial) pairs in contact at least once",
