@@ -7,22 +7,11 @@ Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad inp
 
 import os
 import sys
+from collections.abc import Sequence
 
 import typer
 
 from ar3cli import __version__
-from ar3cli.commands.fix_collision import fix_collision
-from ar3cli.commands.fix_continuous import fix_continuous
-from ar3cli.commands.fix_inertia import fix_inertia
-from ar3cli.commands.fix_joints import fix_joints
-from ar3cli.commands.fix_mesh_paths import fix_mesh_paths
-from ar3cli.commands.fk_verify import fk_verify
-from ar3cli.commands.grasp_demo import grasp_demo
-from ar3cli.commands.info import info
-from ar3cli.commands.install_check import install_check
-from ar3cli.commands.lint_urdf import lint_urdf
-from ar3cli.commands.render import render_command
-from ar3cli.commands.sample_collisions import sample_collisions
 from ar3cli.errors import EXIT_INTERNAL, EXIT_USAGE, UserError
 
 app = typer.Typer(
@@ -50,18 +39,39 @@ def _root(
     """Diagnose, fix and sim-check robot description files (URDF and xacro) with PyBullet."""
 
 
-app.command("install-check")(install_check)
-app.command("info")(info)
-app.command("render")(render_command)
-app.command("fk-verify")(fk_verify)
-app.command("lint-urdf")(lint_urdf)
-app.command("grasp-demo")(grasp_demo)
-app.command("fix-inertia")(fix_inertia)
-app.command("fix-continuous")(fix_continuous)
-app.command("fix-joints")(fix_joints)
-app.command("fix-mesh-paths")(fix_mesh_paths)
-app.command("fix-collision")(fix_collision)
-app.command("sample-collisions")(sample_collisions)
+COMMANDS: dict[str, str] = {
+    "install-check": "ar3cli.commands.install_check:install_check",
+    "info": "ar3cli.commands.info:info",
+    "render": "ar3cli.commands.render:render_command",
+    "fk-verify": "ar3cli.commands.fk_verify:fk_verify",
+    "lint-urdf": "ar3cli.commands.lint_urdf:lint_urdf",
+    "grasp-demo": "ar3cli.commands.grasp_demo:grasp_demo",
+    "fix-inertia": "ar3cli.commands.fix_inertia:fix_inertia",
+    "fix-continuous": "ar3cli.commands.fix_continuous:fix_continuous",
+    "fix-joints": "ar3cli.commands.fix_joints:fix_joints",
+    "fix-mesh-paths": "ar3cli.commands.fix_mesh_paths:fix_mesh_paths",
+    "fix-collision": "ar3cli.commands.fix_collision:fix_collision",
+    "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",
+}
+"""Every command, in the order ``--help`` lists them, and where its function is. A run imports
+only the module of the command it runs (see :func:`application`)."""
+
+
+def application(argv: Sequence[str] | None = None) -> typer.Typer:
+    """The app, with the command ``argv`` (default ``sys.argv[1:]``) starts with registered, or
+    every command when it starts with none (``--help``, ``--version``, a typo: click then lists or
+    suggests them all)."""
+    import importlib
+
+    args = sys.argv[1:] if argv is None else list(argv)
+    names = [args[0]] if args and args[0] in COMMANDS else list(COMMANDS)
+    registered = {info.name for info in app.registered_commands}
+    for name in names:
+        if name not in registered:
+            module, _, function = COMMANDS[name].partition(":")
+            app.command(name)(getattr(importlib.import_module(module), function))
+    app.registered_commands.sort(key=lambda info: list(COMMANDS).index(info.name))
+    return app
 
 
 def _click_exceptions() -> tuple[type, type]:
@@ -88,7 +98,7 @@ def main(argv: list[str] | None = None) -> None:
     _reopen_closed_standard_streams()
     usage_error, no_args = _click_exceptions()
     try:
-        code = app(args=argv, prog_name="ar3cli", standalone_mode=False)
+        code = application(argv)(args=argv, prog_name="ar3cli", standalone_mode=False)
         if code == 130:  # typer turns Ctrl-C into Exit(130)
             print("ar3cli: interrupted", file=sys.stderr)
         sys.exit(code if isinstance(code, int) else 0)

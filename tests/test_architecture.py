@@ -8,6 +8,7 @@ must hold between its ``<!-- layers -->`` markers.
 from __future__ import annotations
 
 import ast
+import re
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -37,6 +38,10 @@ def module_name(path: Path) -> str:
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
 
+LAZY_IMPORT = re.compile(r"ar3cli(\.\w+)+:\w+")
+"""A function named by a string, imported when needed (``importlib.import_module``)."""
+
+
 def package_of(module: str) -> str:
     """``ar3cli.sim.session`` -> ``sim``; ``ar3cli.errors`` -> ``errors``; ``ar3cli`` -> ``__init__``."""
     parts = module.split(".")
@@ -45,10 +50,13 @@ def package_of(module: str) -> str:
 
 def imports_of(path: Path, modules: set[str]) -> set[str]:
     """The ar3cli modules ``path`` imports (``from ar3cli.x import y`` counts ``ar3cli.x.y`` when
-    that is a module, else ``ar3cli.x``)."""
+    that is a module, else ``ar3cli.x``; a ``"ar3cli.x:function"`` string, imported by name later
+    as cli.py's COMMANDS are, counts ``ar3cli.x``)."""
     found: set[str] = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if isinstance(node, ast.Import):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str) and LAZY_IMPORT.fullmatch(node.value):
+            found.add(node.value.partition(":")[0])
+        elif isinstance(node, ast.Import):
             found.update(alias.name for alias in node.names if alias.name.startswith("ar3cli"))
         elif isinstance(node, ast.ImportFrom) and node.module and node.module.startswith("ar3cli") and not node.level:
             for alias in node.names:

@@ -41,8 +41,9 @@ def test_help_texts_survive_markdown_rendering():
 
     import typer.main
 
-    from ar3cli.cli import app
+    from ar3cli.cli import application
 
+    app = application([])
     bare_tag = re.compile(r"(?<!`)<[a-zA-Z_]+>(?!`)")
     for name, command in typer.main.get_command(app).commands.items():
         texts = [command.help or ""] + [getattr(param, "help", None) or "" for param in command.params]
@@ -68,7 +69,7 @@ def test_an_unexpected_os_error_is_one_line_internal_error(monkeypatch, capsys):
     def broken(**_kwargs):
         raise PermissionError(13, "Permission denied", "/somewhere")
 
-    monkeypatch.setattr(cli, "app", broken)
+    monkeypatch.setattr(cli, "application", lambda argv=None: broken)
     monkeypatch.delenv("AR3CLI_DEBUG", raising=False)
     with pytest.raises(SystemExit) as exit_:
         cli.main(["lint-urdf", "x.urdf"])

@@ -8,7 +8,7 @@ import shlex
 import pytest
 import typer.main
 
-from ar3cli.cli import app
+from ar3cli.cli import application
 from tests.conftest import REPO
 
 DOC_FILES = sorted([REPO / "README.md", *(REPO / "docs").rglob("*.md")])
@@ -19,7 +19,7 @@ INVOCATION = re.compile(r"(?<![\w/.-])ar3cli ([a-z][a-z-]+)(?![\w:-])([^\n`|]*)"
 
 def _commands() -> dict:
     """Command name -> click-style command object (typer may vendor click; only duck typing is used)."""
-    return dict(typer.main.get_command(app).commands)
+    return dict(typer.main.get_command(application([])).commands)
 
 
 def _options(command) -> set[str]:
