@@ -139,6 +139,9 @@ def work(item):
         open(sys.argv[1], "a").write(f"{os.getpid()}\\n")
     time.sleep(0.1)
     if os.getpid() == PARENT and item == 4:
+        deadline = time.monotonic() + 20
+        while not os.path.exists(sys.argv[1]) and time.monotonic() < deadline:
+            time.sleep(0.01)  # the child has begun (a slow machine may start it late)
         os.kill(PARENT, signal.SIGKILL)  # as `kill -9` or a timeout would end it
     return item
 map_in_processes(work, list(range(1000)), 2)
@@ -222,13 +225,16 @@ def test_a_child_being_stopped_gets_to_clean_up(tmp_path, no_children_left) -> N
     PyBullet session removes its temporary folder), not killed outright."""
     import time
 
-    marker = tmp_path / "cleaned"
+    marker, started = tmp_path / "cleaned", tmp_path / "started"
 
     def work(item: int) -> int:
         if item == 0:  # this process's share: it fails while the child works
-            time.sleep(0.2)
+            deadline = time.monotonic() + 30
+            while not started.exists() and time.monotonic() < deadline:  # not before (a slow machine
+                time.sleep(0.01)  # once let the SIGINT arrive before the child reached its try block)
             raise ValueError("this process failed")
         try:
+            started.write_text("yes")
             time.sleep(30)
         finally:
             time.sleep(0.2)
