@@ -241,6 +241,12 @@ def test_a_child_being_stopped_gets_to_clean_up(tmp_path, no_children_left) -> N
             marker.write_text("done")
         return item
 
-    with pytest.raises(ValueError, match="this process failed"):
-        map_in_processes(work, [0, 1], 2)
+    # A shell that starts a job in the background (`cmd &`) makes it ignore SIGINT, and a forked
+    # child inherits that: give this process Python's own handler for the test, as a terminal does.
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        with pytest.raises(ValueError, match="this process failed"):
+            map_in_processes(work, [0, 1], 2)
+    finally:
+        signal.signal(signal.SIGINT, previous)
     assert marker.read_text() == "done"
