@@ -71,7 +71,7 @@ def test_a_result_that_cannot_be_pickled_is_an_internal_error_not_a_crash(no_chi
     def lock(item: int):
         return threading.Lock() if item == 1 else item
 
-    with pytest.raises(RuntimeError, match="in a test worker process: TypeError: cannot pickle"):
+    with pytest.raises(RuntimeError, match="in a test worker process: cannot send the result back: TypeError: cannot pickle"):
         map_in_processes(lock, [0, 1], 2, what="a test worker")
 
 

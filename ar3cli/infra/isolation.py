@@ -25,6 +25,7 @@ from collections.abc import Callable
 from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.infra.outcome import capture, pickled, unwrap
 from ar3cli.infra.process_pool import can_fork, sigint_deferred, stop_children
 
 Result = TypeVar("Result")
@@ -111,18 +112,8 @@ def _run_child(work: Callable[[], Result], folder: str, pipe: BinaryIO) -> None:
     os.dup2(2, 1)  # stdout is the parent's (it may carry JSON): whatever the child prints goes to stderr
     tempfile.tempdir = folder
     _stage_pipe = pipe
-    try:
-        outcome = ("ok", work())
-    except UserError as exc:
-        outcome = ("user-error", (exc.message, exc.exit_code))
-    except KeyboardInterrupt:
-        outcome = ("interrupted", None)
-    except BaseException as exc:  # noqa: BLE001 - reported by the parent as an internal error
-        outcome = ("error", f"{type(exc).__name__}: {exc}")
-    try:
-        _send(pipe, outcome)
-    except Exception as exc:  # noqa: BLE001 - e.g. a result that cannot be pickled: a bug
-        _send(pipe, ("error", f"cannot send the result back: {type(exc).__name__}: {exc}"))
+    pipe.write(pickled(capture(work)))
+    pipe.flush()
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(Exception):  # a closed stream must not turn into a crash report
             stream.flush()
@@ -164,14 +155,7 @@ def _reap(pid: int) -> int:
 def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
             cause: Callable[[], str | None] | None) -> Result:
     if answer is not None:
-        kind, payload = answer
-        if kind == "ok":
-            return payload
-        if kind == "user-error":
-            raise UserError(*payload)
-        if kind == "interrupted":
-            raise KeyboardInterrupt
-        raise RuntimeError(payload)
+        return unwrap(answer)
     code = os.waitstatus_to_exitcode(status)
     if code < 0:
         try:

@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import UserError
+from ar3cli.infra.outcome import capture, pickled, unwrap
 
 Item = TypeVar("Item")
 Result = TypeVar("Result")
@@ -123,26 +124,13 @@ def _start_child(function: Callable[[Item], Result], share: Sequence[Item], sibl
             os.close(read_end)
             for pipe in siblings:
                 pipe.close()
-            answer = _answer(lambda: [_unless_orphaned(parent, function, item) for item in share])
+            answer = pickled(capture(lambda: [_unless_orphaned(parent, function, item) for item in share]))
             with os.fdopen(write_end, "wb") as pipe:
                 pipe.write(answer)
         finally:
             os._exit(0)
     os.close(write_end)
     return pid, os.fdopen(read_end, "rb")
-
-
-def _answer(work: Callable[[], list[Result]]) -> bytes:
-    """The pickled outcome of ``work()``: its results, or what went wrong (including results
-    that cannot be pickled, a bug, not a crash)."""
-    import pickle
-
-    try:
-        return pickle.dumps(("ok", work()), protocol=pickle.HIGHEST_PROTOCOL)
-    except UserError as exc:
-        return pickle.dumps(("user-error", (exc.message, exc.exit_code)))
-    except BaseException as exc:  # noqa: BLE001 - reported by the parent
-        return pickle.dumps(("error", f"{type(exc).__name__}: {exc}"))
 
 
 def _unless_orphaned(parent: int, function: Callable[[Item], Result], item: Item) -> Result:
@@ -165,15 +153,11 @@ def _unpack(data: bytes, what: str) -> list[Result]:
     import pickle
 
     try:
-        status, payload = pickle.loads(data)
+        outcome = pickle.loads(data)
     except Exception:  # noqa: BLE001 - an empty or cut answer: the child died
         raise UserError(f"{what} process died (a crash in a C library?); rerun with --jobs 1 to see "
                         "which input causes it") from None
-    if status == "user-error":
-        raise UserError(*payload)
-    if status != "ok":
-        raise RuntimeError(f"in {what} process: {payload}")
-    return payload
+    return unwrap(outcome, f"in {what} process: ")
 
 
 SETTLE_SECONDS = 0.5
