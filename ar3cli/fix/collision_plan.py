@@ -411,12 +411,10 @@ def verify(model, plan: FixPlan) -> dict:
     """Load the written file in PyBullet (in a child); every changed link must have one collision
     shape per ``<collision>``, the part files among them."""
     links = plan.context.get("links", {})
-    if not links:
-        return {"verified": True, "checks": []}
     expected = {link.name: len(link.collisions) for link in model.links if link.name in links}
     files = {name: [str(Path(model.resolver.resolve(uri).path or uri).resolve()) for uri in uris or []]
              for name, uris in links.items()}
-    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, expected, files))
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, expected, files), nothing_changed=not links)
 
 
 def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[str]]) -> list[dict]:

@@ -92,14 +92,18 @@ def check_row(element: str, check: str, ok: bool, detail: str) -> dict[str, str]
     return {"element": element, "check": check, "status": "ok" if ok else "fail", "detail": detail}
 
 
-def verified_in_pybullet(model: Any, checks: Callable[[], list[dict[str, str]]]) -> dict[str, Any]:
-    """Run a verifier's ``checks()`` (pybullet work on the fixed file) in a contained child.
+def verified_in_pybullet(model: Any, checks: Callable[[], list[dict[str, str]]],
+                         nothing_changed: bool = False) -> dict[str, Any]:
+    """Run a verifier's ``checks()`` (pybullet work on the fixed file) in a contained child; when
+    ``nothing_changed``, there is nothing to verify and pybullet is not started.
 
     A file pybullet cannot load, or crashes on, is one failed row as well as ``error`` (the text
     output shows the rows); the temporary file's path is left out of the message.
     """
     from ar3cli.sim.session import run_pybullet
 
+    if nothing_changed:
+        return {"verified": True, "checks": []}
     try:
         rows = run_pybullet(checks, model)
     except UserError as exc:

@@ -187,9 +187,7 @@ def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; each changed joint's limits, effort, velocity and axis as
     getJointInfo reports them must be the new values."""
     joints = plan.context.get("joints", {})
-    if not joints:
-        return {"verified": True, "checks": []}
-    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, joints))
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, joints), nothing_changed=not joints)
 
 
 def _checks_in_pybullet(model, joints: dict) -> list[dict]:

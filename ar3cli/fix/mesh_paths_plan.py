@@ -178,9 +178,7 @@ def verify(model, plan: FixPlan) -> dict:
     """Load the fixed file in PyBullet; every rewritten visual/collision mesh must be loaded from the
     file its old URI pointed to (pybullet's getVisualShapeData / getCollisionShapeData)."""
     meshes = [m for m in plan.context.get("meshes", []) if m["tag"] == "mesh" and m["link"] is not None]
-    if not meshes:
-        return {"verified": True, "checks": []}
-    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, meshes))
+    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, meshes), nothing_changed=not meshes)
 
 
 def _checks_in_pybullet(model, meshes: list[dict]) -> list[dict]:
