@@ -26,7 +26,7 @@ from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import EXIT_USAGE, UserError
 from ar3cli.infra.outcome import capture, pickled, unwrap
-from ar3cli.infra.process_pool import can_fork, sigint_deferred, stop_children
+from ar3cli.infra.process_pool import can_fork, child_signals, sigint_deferred, stop_children
 
 Result = TypeVar("Result")
 
@@ -93,7 +93,7 @@ def _start(work: Callable[[], Result], folder: str, mask: set[signal.Signals]) -
         raise UserError(f"cannot start a process for pybullet: {exc.strerror or exc}") from None
     if pid == 0:  # the child: never returns
         try:
-            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            child_signals(mask)
             os.close(read_end)
             _run_child(work, folder, os.fdopen(write_end, "wb"))
         finally:

@@ -101,6 +101,15 @@ def sigint_deferred() -> Iterator[set[signal.Signals]]:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
+def child_signals(mask: set[signal.Signals]) -> None:
+    """In a forked child, first: SIGINT raises KeyboardInterrupt whatever this process inherited,
+    then the parent's signal ``mask`` is restored. :func:`stop_children` asks a child to stop with
+    SIGINT so that its ``finally`` blocks run; a shell starts a background job (``ar3cli ... &``, a
+    CI step) with SIGINT ignored, and the child would then be killed 3 s later without cleaning up."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
+    signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
 def _start_child(function: Callable[[Item], Result], share: Sequence[Item], siblings: list[BinaryIO],
                  mask: set[signal.Signals]) -> tuple[int, BinaryIO] | None:
     """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe;
@@ -120,7 +129,7 @@ def _start_child(function: Callable[[Item], Result], share: Sequence[Item], sibl
         return None
     if pid == 0:  # the child: never returns
         try:
-            signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+            child_signals(mask)
             os.close(read_end)
             for pipe in siblings:
                 pipe.close()
