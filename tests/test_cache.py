@@ -33,11 +33,11 @@ def test_two_processes_saving_at_once_keep_both_their_entries(folder) -> None:
 
 
 def test_trimming_keeps_the_most_recently_stored(folder) -> None:
-    facts = FileFacts("facts", 1, max_entries=3)
+    facts = FileFacts("facts", 1, max_entries=12)  # a shard keeps a quarter: 3
     for key in "abc":
         facts.store(key, key)
     facts.save()
-    again = FileFacts("facts", 1, max_entries=3)  # the next run
+    again = FileFacts("facts", 1, max_entries=12)  # the next run
     assert again.lookup("a") == "a"
     again.store("a", "A")  # stored again: now the newest
     again.store("d", "d")
@@ -55,13 +55,13 @@ def test_a_store_that_is_not_a_regular_file_is_ignored(folder, tmp_path) -> None
     assert path_state(str(tmp_path / "nothing")) is None
 
 
-def test_one_file_per_folder_and_a_run_reads_only_the_folders_it_asks_about(folder, tmp_path) -> None:
-    """Facts about files of two folders land in two shard files; a later run asking about one folder
-    parses that folder's file alone (with one store file, every run parsed every entry ever saved).
-    The single store file of earlier versions is removed."""
+def test_a_folder_has_one_shard_and_a_run_reads_only_the_shards_it_asks_about(folder, tmp_path) -> None:
+    """Facts about a folder's files share one of the shard files; a later run asking about one
+    folder parses that shard alone (with one store file, every run parsed every entry ever saved).
+    Files of older versions are left alone (an older ar3cli may share the cache folder)."""
     import os
 
-    from ar3cli.infra.file_cache import shard_of
+    from ar3cli.infra.file_cache import SHARDS, shard_of
 
     (tmp_path / "a").mkdir()
     (tmp_path / "b").mkdir()
@@ -75,9 +75,10 @@ def test_one_file_per_folder_and_a_run_reads_only_the_folders_it_asks_about(fold
     facts.put(second, os.stat(second), 2)
     facts.save()
     assert sorted(path.name for path in (folder / "facts-v1").glob("*.json")) == sorted(
-        f"{shard_of(mesh)}.json" for mesh in (first, second))
-    assert not (folder / "facts-v1.json").exists()
+        {f"{shard_of(mesh)}.json" for mesh in (first, second)})
+    assert (folder / "facts-v1.json").read_text() == "{}"
     again = FileFacts("facts", 1)
     assert again.get(first, os.stat(first)) == 1
     assert list(again._shards) == [shard_of(first)]
-    assert shard_of(first) == shard_of(tmp_path / "a" / "other.stl") != shard_of(second)
+    assert shard_of(first) == shard_of(tmp_path / "a" / "other.stl")
+    assert len({shard_of(tmp_path / str(n) / "x.stl") for n in range(1000)}) == SHARDS  # never more files

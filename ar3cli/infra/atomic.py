@@ -40,11 +40,13 @@ def check_writable(path: Path) -> Path:
     return path
 
 
-def atomic_write(path: Path, data: bytes, validate=None) -> None:
+def atomic_write(path: Path, data: bytes, validate=None, durable: bool = True) -> None:
     """Replace ``path`` with ``data`` atomically; ``validate(temp_path)`` may raise to abort.
 
     The temporary file lives in the same folder (so the rename is atomic on one filesystem),
-    is fsynced before the rename and gets the original's mode bits. On any failure it is
+    is fsynced before the rename (and the folder after it) unless not ``durable`` (a cache: losing
+    the newest entries in a power cut costs only time, and a cold lint writes a file per shard),
+    and gets the original's mode bits. On any failure it is
     removed and the original is untouched; an OS error becomes a one-line :class:`UserError`.
     A symlink is written through (its target changes, the link stays a link).
     """
@@ -65,7 +67,8 @@ def atomic_write(path: Path, data: bytes, validate=None) -> None:
         with os.fdopen(handle, "wb") as stream:
             _write_chunks(stream, data)
             stream.flush()
-            os.fsync(stream.fileno())
+            if durable:
+                os.fsync(stream.fileno())
         os.chmod(temp, mode)
         if validate is not None:
             validate(temp)
@@ -76,7 +79,8 @@ def atomic_write(path: Path, data: bytes, validate=None) -> None:
     except BaseException:
         temp.unlink(missing_ok=True)
         raise
-    _fsync_directory(directory)
+    if durable:
+        _fsync_directory(directory)
 
 
 def _write_chunks(stream, data: bytes) -> None:

@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 MAX_ENTRIES = 20_000
-"""Beyond this many entries the least recently stored are dropped when saving (the cache stays small)."""
+"""A cache's size: each of its :data:`SHARDS` files keeps its newest ``MAX_ENTRIES / 4`` entries."""
 
 MISSING = object()
 
@@ -50,8 +50,10 @@ _OPEN: dict[str, FileFacts] = {}
 
 COMMON_SHARD = "common"
 """The shard of entries stored without a path to place them by."""
-MAX_SHARDS = 2_000
-"""Shard files kept per cache; beyond this the least recently written are removed when saving."""
+SHARDS = 64
+"""Shard files per cache at most: a folder's entries all go to one of them (by a checksum of its
+path), so a run that lints one robot parses about 1/64 of the cache, and a cold lint of a large
+tree (pybullet_data's 1,000 random_urdfs folders) writes 64 files, not one per folder."""
 
 
 def cache_dir() -> Path | None:
@@ -69,8 +71,8 @@ def shard_of(near: str | os.PathLike[str] | None) -> str:
     if near is None:
         return COMMON_SHARD
     folder = os.path.dirname(os.path.abspath(near))
-    # a checksum, not a secure hash (hashlib costs an import): two folders sharing a shard only share a file
-    return f"{zlib.crc32(folder.encode('utf-8', 'surrogateescape')):08x}"
+    # a checksum, not a secure hash (hashlib costs an import): folders sharing a shard only share a file
+    return f"{zlib.crc32(folder.encode('utf-8', 'surrogateescape')) % SHARDS:02x}"
 
 
 class FileFacts:
@@ -78,9 +80,10 @@ class FileFacts:
 
     Keys are built from a file's path and stat (:meth:`get` / :meth:`put`) or given whole by the
     caller (:meth:`lookup` / :meth:`store`, placed by the file they are about: ``near``). Entries
-    are kept in one shard file per folder, and a run reads only the shards of the folders it asks
-    about: with one store file, every run parsed every entry ever saved (4,400 mesh boxes, 0.9 MB:
-    12 ms of each lint; 20,000: ~50 ms). At most ``max_entries`` are kept per shard.
+    are kept in :data:`SHARDS` files, all of a folder's in one, and a run reads only the shards of
+    the folders it asks about: with one store file, every run parsed every entry ever saved (4,400
+    mesh boxes, 0.9 MB: 12 ms of each lint). At most ``max_entries`` / 4 are kept per shard (a
+    folder's entries share one), so about ``16 * max_entries`` in all.
     """
 
     def __init__(self, name: str, version: int, max_entries: int = MAX_ENTRIES) -> None:
@@ -138,10 +141,10 @@ class FileFacts:
             self._saving = True
 
     def save(self) -> None:
-        """Write what this process stored into its shard files, atomically and under a lock, on top
-        of what is there now (other processes may have saved since this one read them); only the
-        newest :attr:`max_entries` of a shard are kept, and the :data:`MAX_SHARDS` most recently
-        written shards. Failures are silent (a cache is optional)."""
+        """Write what this process stored into its shard files, atomically (not fsynced: a cache)
+        and under a lock, on top of what is there now (other processes may have saved since this
+        one read them); only the newest entries of a shard are kept (see the class). Failures are
+        silent (a cache is optional)."""
         folder = self._folder()
         if not self._changed or folder is None:
             return
@@ -156,25 +159,13 @@ class FileFacts:
                     for key, value in changed.items():
                         entries.pop(key, None)
                         entries[key] = value
-                    if len(entries) > self.max_entries:
-                        entries = dict(list(entries.items())[-self.max_entries:])
-                    atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"))
-                _remove_oldest(folder, MAX_SHARDS)
-                legacy = folder.with_name(f"{folder.name}.json")  # ar3cli <= 0.1's one store file
-                legacy.unlink(missing_ok=True)
-                legacy.with_name(legacy.name + ".lock").unlink(missing_ok=True)
+                    keep = max(1, self.max_entries // 4)
+                    if len(entries) > keep:
+                        entries = dict(list(entries.items())[-keep:])
+                    atomic_write(location, json.dumps(entries, separators=(",", ":")).encode("utf-8"), durable=False)
             self._changed = {}
         except Exception:  # noqa: BLE001 - a read-only home must never break a lint
             pass
-
-
-def _remove_oldest(folder: Path, keep: int) -> None:
-    """Remove all but the ``keep`` most recently written shard files of ``folder``."""
-    shards = list(folder.glob("*.json"))
-    if len(shards) > keep:
-        shards.sort(key=lambda shard: shard.stat().st_mtime_ns)
-        for shard in shards[:-keep]:
-            shard.unlink(missing_ok=True)
 
 
 def _read_entries(location: Path) -> dict[str, Any]:
