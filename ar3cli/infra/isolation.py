@@ -57,7 +57,7 @@ def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], s
     (an internal error); a child that dies raises :class:`CrashError`, e.g.
     ``ur5.urdf: pybullet crashed (SIGSEGV) while loading it``, ``subject`` being the file, followed
     by what ``cause()`` says is the likely reason (asked only after a crash), if anything.
-    Ctrl-C stops the child (it gets a moment to finish, then SIGINT, then SIGKILL).
+    Ctrl-C stops the child (it gets a moment to finish, then SIGTERM, then SIGKILL).
     """
     if not can_fork():
         return work()

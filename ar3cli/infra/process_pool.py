@@ -102,12 +102,18 @@ def sigint_deferred() -> Iterator[set[signal.Signals]]:
 
 
 def child_signals(mask: set[signal.Signals]) -> None:
-    """In a forked child, first: SIGINT raises KeyboardInterrupt whatever this process inherited,
-    then the parent's signal ``mask`` is restored. :func:`stop_children` asks a child to stop with
-    SIGINT so that its ``finally`` blocks run; a shell starts a background job (``ar3cli ... &``, a
-    CI step) with SIGINT ignored, and the child would then be killed 3 s later without cleaning up."""
-    signal.signal(signal.SIGINT, signal.default_int_handler)
+    """In a forked child, first: SIGTERM raises KeyboardInterrupt, then the parent's signal
+    ``mask`` is restored. SIGTERM is how :func:`stop_children` asks a child to stop so that its
+    ``finally`` blocks run (a PyBullet session removes its folder). SIGINT stays as the parent had
+    it: a background job (``ar3cli ... &``, a CI step) is started with SIGINT ignored, and so stays
+    uninterruptible, children included; asking with SIGINT found such a child deaf, and it was
+    killed 3 s later without cleaning up."""
+    signal.signal(signal.SIGTERM, _stop_requested)
     signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+
+
+def _stop_requested(_signal_number: int, _frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def _start_child(function: Callable[[Item], Result], share: Sequence[Item], siblings: list[BinaryIO],
@@ -173,20 +179,20 @@ SETTLE_SECONDS = 0.5
 """After Ctrl-C (which the children get too) a child is left this long to clean up on its own
 (a PyBullet session removes its temporary folder) before it is asked to stop."""
 STOP_SECONDS = 3.0
-"""A child asked to stop (SIGINT) gets this long before it is killed."""
+"""A child asked to stop (SIGTERM, see :func:`child_signals`) gets this long before it is killed."""
 
 
 def stop_children(children: list[tuple[int, BinaryIO]], settle: bool) -> None:
     """End the remaining children: closed pipes, a moment to finish after Ctrl-C (``settle``),
-    SIGINT, then SIGKILL. A second Ctrl-C meanwhile waits until they are gone (a few seconds at
-    most), so none is left running."""
+    SIGTERM (which a forked child turns into KeyboardInterrupt), then SIGKILL. A second Ctrl-C
+    meanwhile waits until they are gone (a few seconds at most), so none is left running."""
     if not children:
         return
     with sigint_deferred():
         for _, pipe in children:
             pipe.close()  # a child still writing its answer gets EPIPE and ends
         running = {pid for pid, _ in children}
-        steps = ((None, SETTLE_SECONDS if settle else 0.0), (signal.SIGINT, STOP_SECONDS), (signal.SIGKILL, None))
+        steps = ((None, SETTLE_SECONDS if settle else 0.0), (signal.SIGTERM, STOP_SECONDS), (signal.SIGKILL, None))
         for action, seconds in steps:
             for pid in running if action else ():
                 with contextlib.suppress(ProcessLookupError):
