@@ -23,6 +23,8 @@ app = typer.Typer(
     add_completion=False,
     context_settings={"help_option_names": ["-h", "--help"]},
 )
+"""The Typer app with its callback only: :func:`application` registers the commands (all of them, or
+the one a command line runs). Use ``application([])`` for the complete app (CliRunner, docs)."""
 
 
 def _version_callback(value: bool) -> None:
@@ -70,7 +72,8 @@ def application(argv: Sequence[str] | None = None) -> typer.Typer:
         if name not in registered:
             module, _, function = COMMANDS[name].partition(":")
             app.command(name)(getattr(importlib.import_module(module), function))
-    app.registered_commands.sort(key=lambda info: list(COMMANDS).index(info.name))
+    order = {name: index for index, name in enumerate(COMMANDS)}
+    app.registered_commands.sort(key=lambda info: order.get(info.name or "", len(order)))
     return app
 
 

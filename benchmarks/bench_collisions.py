@@ -160,7 +160,7 @@ for k, a in enumerate(solid):
             category = "adjacent"
         elif key in home:
             category = "default"
-        elif n / samples >= threshold:
+        elif samples and n / samples >= threshold:
             category = "always"
         elif n == 0 and key not in at_limits:
             category = "never"
@@ -184,9 +184,11 @@ def verdicts(robot: Path, samples: int, document: dict) -> str:
         return f"independent all-pairs check failed: {done.stderr.strip()[-500:]}"
     theirs = json.loads(done.stdout.strip().splitlines()[-1])
     ours = {"|".join(sorted((pair["link_a"], pair["link_b"]))): pair for pair in document["pairs"]}
-    differing = [f"{key}: ar3cli {ours[key]['category']} ({ours[key]['collisions']}), independent "
-                 f"{theirs[key][0]} ({theirs[key][1]})" for key in sorted(theirs)
-                 if key not in ours or ours[key]["category"] != theirs[key][0]]
+    def said(key: str) -> str:
+        return f"{ours[key]['category']} ({ours[key]['collisions']})" if key in ours else "absent"
+
+    differing = [f"{key}: ar3cli {said(key)}, independent {theirs[key][0]} ({theirs[key][1]})"
+                 for key in sorted(theirs) if key not in ours or ours[key]["category"] != theirs[key][0]]
     count_differs = sum(1 for key, pair in ours.items() if pair.get("sampled", True)
                            and key in theirs and pair["collisions"] != theirs[key][1])
     same = len(theirs) - len(differing)
