@@ -11,9 +11,8 @@ panda_link8; talos_reduced's 72 such pairs) keep their relative pose, so they ar
 load and then filtered out with ``setCollisionFilterPair`` (:attr:`Checker.constant`): their count is
 every configuration or none, exactly what testing them every time gives, at no cost per
 configuration (measured in-process: 36 -> 24 us per configuration on the panda, 900 -> 675 us on
-talos_reduced). How often a pair
-adjacent across a geometry-less link touches is what the ``pybullet-default-self-collision``
-warning reports.
+talos_reduced). How often a pair adjacent across a geometry-less link touches is what the
+``pybullet-default-self-collision`` warning reports.
 Whole-process timings against the plain script a user would write are in ``benchmarks/``.
 
 Two measured facts shape this module:
@@ -118,11 +117,7 @@ class Checker:
         """Pair ids penetrating deeper than the tolerance at the current pose (after a fresh collision pass)."""
         p, client = self.session.p, self.session.client
         p.performCollisionDetection(physicsClientId=client)
-        hits = {self._lookup[point[3] + 1][point[4] + 1]
-                for point in p.getContactPoints(self.body.id, self.body.id, physicsClientId=client)
-                if point[8] < -PENETRATION_TOLERANCE}
-        hits.discard(-1)
-        return hits
+        return _penetrating(p.getContactPoints(self.body.id, self.body.id, physicsClientId=client), self._lookup)
 
     def __enter__(self) -> Checker:
         return self
@@ -150,16 +145,14 @@ class Checker:
     def _check(self, configs: np.ndarray, hits_out: set[int] | None = None) -> np.ndarray:
         p, client, body = self.session.p, self.session.client, self.body.id
         reset, detect, contacts = p.resetJointStatesMultiDof, p.performCollisionDetection, p.getContactPoints
-        lookup, indices, tolerance = self._lookup, self._joint_indices, -PENETRATION_TOLERANCE
+        lookup, indices = self._lookup, self._joint_indices
         counts = [0] * len(self.pairs)
         targets = configs[:, :, None].tolist()  # [[q0], [q1], ...] per row, as resetJointStatesMultiDof wants
         for target in targets:
             if indices:
                 reset(body, indices, target, physicsClientId=client)
             detect(physicsClientId=client)
-            hits = {lookup[point[3] + 1][point[4] + 1]
-                    for point in contacts(body, body, physicsClientId=client) if point[8] < tolerance}
-            hits.discard(-1)
+            hits = _penetrating(contacts(body, body, physicsClientId=client), lookup)
             for pair_id in hits:
                 counts[pair_id] += 1
             if hits_out is not None:
@@ -170,6 +163,13 @@ class Checker:
             hits_out.difference_update(self.constant)
             hits_out.update(self._constant_hits if targets else ())
         return np.array(counts, dtype=np.int64)
+
+
+def _penetrating(points: Sequence[tuple], lookup: list[list[int]]) -> set[int]:
+    """The pair ids (``lookup[a + 1][b + 1]``) of contact ``points`` deeper than the tolerance."""
+    hits = {lookup[point[3] + 1][point[4] + 1] for point in points if point[8] < -PENETRATION_TOLERANCE}
+    hits.discard(-1)
+    return hits
 
 
 # ---- parallel counting ----------------------------------------------------------------------------
