@@ -4,7 +4,7 @@ A pre-commit hook or a CI step lints the same meshes again and again; reading 50
 STL text takes longer than all the rules together. Facts are keyed by the file's absolute path
 (not resolved through symlinks: realpath costs more than the lookup it serves), modification and
 status-change times (ns) and size, so an edited mesh is read again. Each kind of fact is a folder
-of JSON files, one per folder of the files the facts are about (a run reads only the ones it needs),
+of :data:`SHARDS` JSON files, a folder's facts all in one (a run reads only the ones it needs),
 written atomically at exit and only when something new was learnt, merged under a lock with what
 other ar3cli processes saved meanwhile (pre-commit runs several at once); a corrupt or unreadable
 file is ignored (and rebuilt). ``AR3CLI_NO_CACHE=1`` turns it off;
@@ -67,7 +67,8 @@ def cache_dir() -> Path | None:
 
 
 def shard_of(near: str | os.PathLike[str] | None) -> str:
-    """The shard holding entries about ``near``: one per folder (a robot's meshes sit together)."""
+    """The shard holding entries about ``near``: the same for every file of a folder (a robot's
+    meshes sit together), one of :data:`SHARDS`; :data:`COMMON_SHARD` without a path."""
     if near is None:
         return COMMON_SHARD
     folder = os.path.dirname(os.path.abspath(near))

@@ -17,7 +17,7 @@ and reuses them while nothing they depend on has changed:
 
 Only static lints of ``.urdf`` files that loaded are remembered: xacro expansion reads includes
 that ar3cli does not see, and ``--sim`` results depend on PyBullet. ``--no-cache`` or
-``AR3CLI_NO_CACHE=1`` turn it off; the store is ``<cache dir>/lint-results-v1/`` (one file per folder)
+``AR3CLI_NO_CACHE=1`` turn it off; the store is ``<cache dir>/lint-results-v1/`` (sharded by folder)
 (:mod:`ar3cli.infra.file_cache`).
 """
 
@@ -34,8 +34,9 @@ from ar3cli.findings import Finding, Severity
 from ar3cli.infra.file_cache import MISSING, PathState, file_facts, path_state
 
 MAX_RESULTS = 2_000
-"""Remembered files per folder; beyond this the least recently stored are dropped. A run reads the
-store of each folder it lints (0.5 to 2.5 kB a file)."""
+"""Remembered files: each shard of the store keeps its newest quarter of this (a folder's files share
+a shard, see :mod:`ar3cli.infra.file_cache`). A run reads the shards of the folders it lints (0.5
+to 2.5 kB a file)."""
 
 _STORE = file_facts("lint-results", version=1, max_entries=MAX_RESULTS)
 _PACKAGE_DIR = Path(__file__).resolve().parents[1]
