@@ -73,3 +73,27 @@ def test_p002_reports_a_shallow_overlap_in_micrometres(write_urdf):
     options = LintOptions(sim=True)
     (finding,) = [f for f in lint_file(write_urdf(text), options.rules(), options).findings if f.rule == "P002"]
     assert "'base' and 'tip'" in finding.message and "by 5.0 µm" in finding.message
+
+
+def test_p002_is_quiet_about_links_joined_only_by_fixed_joints(write_urdf):
+    """base - plate (fixed) - cover (fixed) with cover overlapping base: one rigid part, never apart, so no P002;
+    an arm link overlapping the same base through a revolute joint chain is still reported."""
+    from ar3cli.lint.engine import LintOptions, lint_file
+    from ar3cli.lint.rules.base import LINK_INERTIAL, robot
+
+    box = '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>'
+    small = '<collision><geometry><box size="0.02 0.02 0.02"/></geometry></collision>'
+    text = robot(f"""
+        <link name="base">{LINK_INERTIAL}{box}</link><link name="plate">{LINK_INERTIAL}{small}</link>
+        <link name="cover">{LINK_INERTIAL}{box}</link>
+        <link name="arm">{LINK_INERTIAL}{small}</link><link name="hand">{LINK_INERTIAL}{box}</link>
+        <joint name="f1" type="fixed"><parent link="base"/><child link="plate"/><origin xyz="0 0 0.3"/></joint>
+        <joint name="f2" type="fixed"><parent link="plate"/><child link="cover"/><origin xyz="0 0 -0.2"/></joint>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0.3 0"/>
+          <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+        <joint name="j2" type="revolute"><parent link="arm"/><child link="hand"/><origin xyz="0 -0.2 0"/>
+          <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>""")
+    options = LintOptions(sim=True)
+    messages = [f.message for f in lint_file(write_urdf(text), options.rules(), options).findings if f.rule == "P002"]
+    assert not [m for m in messages if "'cover'" in m and "'base'" in m]
+    assert [m for m in messages if "'base'" in m and "'hand'" in m]

@@ -75,22 +75,27 @@ def _stacked_boxes(tip_z: float) -> str:
       overlapping collision meshes or a wrong joint origin. With self-collision on, PyBullet pushes
       them apart the moment the simulation starts; planners see the start state as invalid.
       Adjacent is MoveIt's rule, as in sample-collisions: joined by a joint, looking through links
-      without collision geometry (their overlap is by construction).""",
+      without collision geometry (their overlap is by construction). Links joined only through
+      fixed joints (one rigid group, as sample-collisions settles them) are not reported: they can
+      never move apart, so their overlap is how the part is built, not a pose to fix.""",
       fix="Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
           "(SRDF / setCollisionFilterPair).",
       bad=_stacked_boxes(tip_z=-0.25), good=_stacked_boxes(tip_z=0.25),
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
-    from ar3cli.sim.adjacency import nonadjacent_collisions
+    from ar3cli.sim.adjacency import nonadjacent_collisions, rigid_groups
     from ar3cli.urdf.srdf import is_disabled
 
     with _loaded(ctx, self_collision="all-pairs") as body:
         if body is None:
             return
         body.set_positions(_home(body))
+        group = rigid_groups(ctx.model, (joint.name for joint in body.actuated_joints))
         for a, b, depth in nonadjacent_collisions(body):
             if is_disabled(ctx.srdf_disabled, a, b):
                 continue  # the user's SRDF tells MoveIt not to check this pair
+            if a in group and group[a] == group.get(b):
+                continue  # joined only by fixed joints: they can never move apart (issue 30 item 8)
             link = ctx.model.link(b) or ctx.model.link(a)
             yield Hit(f"links '{a}' and '{b}' interpenetrate by {_depth_text(-depth)} at the home pose",
                       link.element if link else None)
