@@ -148,6 +148,55 @@ def test_non_unit_prismatic_axis_fails_with_an_explanation(cli, write_urdf) -> N
     assert any("non-unit axis" in note and "pybullet moves the joint 3 x q" in note for note in data["notes"])
 
 
+def _mobile_urdf(x_axis: str = "1 0 0") -> str:
+    """A virtual planar base (prismatic x, y of +-20 m, a yaw joint) carrying a two-link arm, like Fetch or a
+    mobile Panda: pybullet's float32 frames are off by ~1e-6 m out there although nothing is wrong."""
+    inertial = ('<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+                '</inertial>')
+    links = "".join(f'<link name="{name}">{inertial}</link>' for name in ("x_link", "y_link", "base", "upper", "fore"))
+
+    def joint(name: str, kind: str, parent: str, child: str, axis: str, limit: float, xyz: str = "0 0 0") -> str:
+        return (f'<joint name="{name}" type="{kind}"><parent link="{parent}"/><child link="{child}"/>'
+                f'<origin xyz="{xyz}"/><axis xyz="{axis}"/>'
+                f'<limit lower="{-limit}" upper="{limit}" effort="100" velocity="1"/></joint>')
+
+    return (f'<robot name="mobile"><link name="world"/>{links}'
+            + joint("x", "prismatic", "world", "x_link", x_axis, 20) + joint("y", "prismatic", "x_link", "y_link", "0 1 0", 20)
+            + joint("theta", "revolute", "y_link", "base", "0 0 1", 3.14)
+            + joint("shoulder", "revolute", "base", "upper", "0 1 0", 2, "0.1 0 0.4")
+            + joint("elbow", "revolute", "upper", "fore", "0 1 0", 2, "0 0 0.3") + "</robot>")
+
+
+def test_a_mobile_base_20_m_out_passes_with_a_tolerance_scaled_to_its_reach(cli, write_urdf) -> None:
+    path = str(write_urdf(_mobile_urdf()))
+    result, data = run_json(cli, path, "--samples", "300")
+    assert result.code == 0, result.stderr
+    assert data["passed"] is True and data["tolerance_scaled"] is True and data["tolerance_m"] == 1e-6
+    assert data["max_position_error_m"] > 1e-6  # float32 at ~20 m: an absolute 1e-6 m would call it FAIL
+    fore = next(link for link in data["links"] if link["link"] == "fore")
+    assert fore["max_reach_m"] > 20 and fore["position_tolerance_m"] == pytest.approx(4 * 2.0**-23 * fore["max_reach_m"])
+    assert data["largest_position_tolerance_m"] == pytest.approx(max(link["position_tolerance_m"] for link in data["links"]))
+    text = cli("fk-verify", path, "--samples", "300")
+    assert "PASS" in text.stdout and "float32 epsilons x reach" in text.stdout and "m reach)" in text.stdout
+    given = cli("fk-verify", path, "--samples", "300", "--tolerance-m", "1e-6")  # a tolerance the user gives is used as is
+    assert given.code == 1 and "1e-06 m as given" in given.stdout
+
+
+def test_a_real_error_on_a_mobile_base_still_fails(cli, write_urdf) -> None:
+    """An axis 1e-5 too long: pybullet moves x by |axis| q, 0.2 mm off at 20 m, far above the scaled 1e-5 m."""
+    result, data = run_json(cli, str(write_urdf(_mobile_urdf(x_axis="1.00001 0 0"))), "--samples", "300")
+    assert result.code == 1 and data["passed"] is False
+    assert data["max_position_error_m"] > 1e-4 > data["largest_position_tolerance_m"]
+
+
+def test_link_reach_includes_the_ancestors() -> None:
+    """An arm folded back to the origin from a base 20 m out is rounded like a point 20 m out."""
+    frames = {name: np.tile(np.eye(4), (1, 1, 1)) for name in ("base", "arm")}
+    frames["base"][0, :3, 3] = (20, 0, 0)
+    reaches = fk_compare.link_reaches(frames, {"arm": "base"})
+    assert reaches["arm"][0] == pytest.approx(20) and reaches["base"][0] == pytest.approx(20)
+
+
 # ---- DH tables ----------------------------------------------------------------------------------
 
 def test_ar3_dh_passes(cli) -> None:

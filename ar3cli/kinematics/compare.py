@@ -11,6 +11,7 @@ moves prismatic joints by ``|axis| * q``), and the base pose being the COM in py
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -40,7 +41,12 @@ class Samples:
 
 @dataclass
 class LinkError:
-    """Errors of one link frame over all samples."""
+    """Errors of one link frame over all samples.
+
+    ``position_errors`` and ``reaches`` hold one value per sample: the reach is how far from the
+    world origin the link or one of its ancestors is in that sample (m), which bounds pybullet's
+    single-precision rounding there (see :class:`ar3cli.kinematics.verify.Tolerance`).
+    """
 
     link: str
     max_position: float
@@ -48,11 +54,18 @@ class LinkError:
     max_orientation: float
     mean_orientation: float
     worst_sample: int
+    position_errors: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    reaches: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
-    def to_dict(self) -> dict:
+    @property
+    def max_reach(self) -> float:
+        return float(self.reaches.max()) if self.reaches.size else 0.0
+
+    def to_dict(self) -> dict[str, Any]:
         return {"link": self.link, "max_position_error_m": self.max_position,
                 "mean_position_error_m": self.mean_position, "max_orientation_error_rad": self.max_orientation,
-                "mean_orientation_error_rad": self.mean_orientation, "worst_sample": self.worst_sample}
+                "mean_orientation_error_rad": self.mean_orientation, "worst_sample": self.worst_sample,
+                "max_reach_m": self.max_reach}
 
 
 @dataclass
@@ -114,8 +127,13 @@ def frames_from_poses(links: list[str], poses) -> dict[str, np.ndarray]:
     return result
 
 
-def compare_links(reference: dict[str, np.ndarray], measured: dict[str, np.ndarray]) -> list[LinkError]:
-    """Per-link max/mean errors for links present in both, in ``measured`` order."""
+def compare_links(reference: dict[str, np.ndarray], measured: dict[str, np.ndarray],
+                  parents: dict[str, str] | None = None) -> list[LinkError]:
+    """Per-link max/mean errors for links present in both, in ``measured`` order.
+
+    ``parents`` (child link -> parent link) lets each link's reach include its ancestors'.
+    """
+    reaches = link_reaches(reference, parents or {})
     errors = []
     for link, frames in measured.items():
         if link not in reference:
@@ -124,8 +142,30 @@ def compare_links(reference: dict[str, np.ndarray], measured: dict[str, np.ndarr
         worst = int(np.argmax(position / max(float(position.max()), 1e-300)
                               + angle / max(float(angle.max()), 1e-300)))
         errors.append(LinkError(link, float(position.max()), float(position.mean()), float(angle.max()),
-                                float(angle.mean()), worst))
+                                float(angle.mean()), worst, position, reaches[link]))
     return errors
+
+
+def link_reaches(reference: dict[str, np.ndarray], parents: dict[str, str]) -> dict[str, np.ndarray]:
+    """Per link, per sample: the largest distance from the world origin of the link or an ancestor (m).
+
+    pybullet composes the frames in single precision from the base out, so a link's rounding error
+    grows with the largest coordinate met along its chain (a mobile base 20 m out, an arm folded
+    back to the origin), not only with its own position.
+    """
+    reaches: dict[str, np.ndarray] = {}
+    for link in reference:
+        chain: list[str] = []  # the link and its ancestors not yet measured, child first (iterative: chains can be long)
+        node: str | None = link
+        while node is not None and node in reference and node not in reaches and node not in chain:
+            chain.append(node)
+            node = parents.get(node)
+        above = reaches.get(node) if node is not None else None
+        for name in reversed(chain):
+            own = np.linalg.norm(reference[name][..., :3, 3], axis=-1)
+            above = own if above is None else np.maximum(own, above)
+            reaches[name] = above
+    return reaches
 
 
 def model_notes(model: Model, body) -> list[str]:
@@ -160,4 +200,6 @@ def compare(model: Model, body, samples: Samples) -> Comparison:
     """Run both FKs over ``samples`` and measure every link."""
     reference = kinematics.urdf_link_frames(model, samples.all_values, samples.count)
     measured = pybullet_frames(body, samples)
-    return Comparison(links=compare_links(reference, measured), notes=model_notes(model, body), reference=reference)
+    parents = {joint.child: joint.parent for joint in model.joints if joint.child and joint.parent}
+    return Comparison(links=compare_links(reference, measured, parents), notes=model_notes(model, body),
+                      reference=reference)

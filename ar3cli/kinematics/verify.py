@@ -15,22 +15,61 @@ from ar3cli.kinematics import dh as dh_module
 from ar3cli.output.report import Report, Table, log
 from ar3cli.urdf.model import Model
 
+FLOAT32_EPSILON = 2.0 ** -23
+"""Spacing of single-precision numbers at 1.0 (1.19e-7): pybullet computes and reports link frames in
+float32, so a coordinate near x metres is only known to about x times this."""
+REACH_EPSILONS = 4.0
+"""The scaled position tolerance is this many float32 epsilons times the reach. Measured on a mobile
+base with prismatic x/y joints of +-20 m and a two-link arm (tests/test_fk_verify.py): errors up to
+0.5 epsilon x reach (1.3e-6 m at 22 m); Fetch, a mobile Panda and a Dingo-Kinova show 1.1-2.4e-6 m at
+10-20 m. 4 epsilons leave room for rounding that accumulates along a chain while a 0.1 mm mistake at
+20 m still fails (the allowance there is 9.5e-6 m)."""
 ERROR_COLUMNS = ["max position (m)", "mean position (m)", "max orientation (rad)", "mean orientation (rad)"]
 
 
 @dataclass(frozen=True)
 class Tolerance:
-    """Largest position (m) and orientation (rad, geodesic) errors that pass."""
+    """Largest position (m) and orientation (rad, geodesic) errors that pass.
+
+    With ``scaled`` (the default: no ``--tolerance-m`` given), the position tolerance of a link in a
+    sample is ``max(position, REACH_EPSILONS * FLOAT32_EPSILON * reach)``: far from the origin (a
+    mobile base's virtual joints reach +-20 m) float32 frames cannot be closer than that, and an
+    absolute 1e-6 m would fail a correct robot. A tolerance the user gives is used as given.
+    Orientation errors do not grow with distance, so the orientation tolerance is always absolute.
+    """
 
     position: float
     orientation: float
+    scaled: bool = False
 
-    def passes(self, position: float, orientation: float) -> bool:
-        return position <= self.position and orientation <= self.orientation
+    @property
+    def per_metre(self) -> float:
+        """Position tolerance per metre of reach (0 when not scaled)."""
+        return REACH_EPSILONS * FLOAT32_EPSILON if self.scaled else 0.0
 
-    def severity(self, position: float, orientation: float) -> float:
-        """How far past the tolerance (1 = at it), for picking the worst case."""
-        return max(position / self.position, orientation / self.orientation)
+    def position_at(self, reach: Any) -> Any:
+        """The position tolerance at ``reach`` metres (a float or an array of them)."""
+        import numpy as np
+
+        return np.maximum(self.position, self.per_metre * np.asarray(reach, dtype=float))
+
+    def passes(self, position: float, orientation: float, reach: float = 0.0) -> bool:
+        return position <= float(self.position_at(reach)) and orientation <= self.orientation
+
+    def link_severity(self, error: fk_compare.LinkError) -> float:
+        """How far past the tolerance the link's worst sample is (1 = at it), for the worst case and the verdict."""
+        position = float((error.position_errors / self.position_at(error.reaches)).max()) \
+            if error.position_errors.size else error.max_position / self.position
+        return max(position, error.max_orientation / self.orientation)
+
+    def link_passes(self, error: fk_compare.LinkError) -> bool:
+        return self.link_severity(error) <= 1.0
+
+    def describe(self) -> str:
+        """The rule in words, for the verdict line."""
+        if not self.scaled:
+            return f"{self.position:g} m as given"
+        return f"max({self.position:g} m, {REACH_EPSILONS:g} float32 epsilons x reach)"
 
 
 @dataclass
@@ -63,6 +102,8 @@ def check_dh(table: dh_module.DHTable, dh_path: Path, drawn: fk_compare.Samples,
     """Evaluate the DH table's tip against the URDF's over the same samples, with diagnoses."""
     import numpy as np
 
+    tip = next((error for error in comparison.links if error.link == table.tip), None)
+    tolerance = Tolerance(float(tolerance.position_at(tip.max_reach if tip else 0.0)), tolerance.orientation)
     q = dh_module.joint_matrix(table, drawn.all_values)
     evaluation = dh_module.evaluate(table, comparison.reference, q)
     ok = evaluation.within(tolerance.position, tolerance.orientation)
@@ -73,6 +114,7 @@ def check_dh(table: dh_module.DHTable, dh_path: Path, drawn: fk_compare.Samples,
               float(evaluation.orientation_error.mean())]
     data = {
         "path": str(dh_path), "convention": table.convention, "base": table.base, "tip": table.tip, "passed": ok,
+        "tolerance_m": tolerance.position,
         **dict(zip(("max_position_error_m", "mean_position_error_m", "max_orientation_error_rad",
                     "mean_orientation_error_rad"), errors)),
         "worst_configuration": drawn.configuration(worst),
@@ -89,15 +131,19 @@ def fk_report(model: Model, path: Path, samples: int, seed: int, tolerance: Tole
               comparison: fk_compare.Comparison, dh: DhCheck | None) -> Report:
     """The JSON document, the link table (and the DH table), the notes and one verdict line."""
     links = comparison.links
-    worst = max(links, key=lambda e: tolerance.severity(e.max_position, e.max_orientation))
-    passed = all(tolerance.passes(e.max_position, e.max_orientation) for e in links) and (dh is None or dh.ok)
+    worst = max(links, key=tolerance.link_severity)
+    passed = all(tolerance.link_passes(e) for e in links) and (dh is None or dh.ok)
+    largest = max(float(tolerance.position_at(e.max_reach)) for e in links)
     max_position = max([e.max_position for e in links] + ([dh.data["max_position_error_m"]] if dh else []))
     max_orientation = max([e.max_orientation for e in links] + ([dh.data["max_orientation_error_rad"]] if dh else []))
     data: dict[str, Any] = {
         "path": str(path), "samples": samples, "seed": seed, "passed": passed,
         "tolerance_m": tolerance.position, "tolerance_rad": tolerance.orientation,
+        "tolerance_scaled": tolerance.scaled, "tolerance_m_per_m_reach": tolerance.per_metre,
+        "largest_position_tolerance_m": largest,
         "max_position_error_m": max_position, "max_orientation_error_rad": max_orientation,
-        "links": [e.to_dict() for e in links],
+        "links": [{**e.to_dict(), "position_tolerance_m": float(tolerance.position_at(e.max_reach)),
+                   "passed": tolerance.link_passes(e)} for e in links],
         "worst": {"link": worst.link, "sample": worst.worst_sample,
                   "configuration": drawn.configuration(worst.worst_sample)},
         "notes": comparison.notes, "dh": dh.data if dh else None,
@@ -105,13 +151,15 @@ def fk_report(model: Model, path: Path, samples: int, seed: int, tolerance: Tole
     link_table = _error_table(
         f"PyBullet link frames vs URDF FK: {model.path.name}, {samples} samples, seed {seed}", "link",
         [[e.link, e.max_position, e.mean_position, e.max_orientation, e.mean_orientation,
-          "pass" if tolerance.passes(e.max_position, e.max_orientation) else "fail"] for e in links],
+          "pass" if tolerance.link_passes(e) else "fail"] for e in links],
         caption="pybullet reports link frames in single precision: ~1e-7 m / ~6e-7 rad is its floor")
     lines = [f"note: {note}" for note in comparison.notes] + (dh.lines if dh else [])
     lines.append(f"worst link: {worst.link} (sample {worst.worst_sample}: "
                  f"{_configuration(drawn.configuration(worst.worst_sample))})")
+    scaled = (f", up to {largest:.3g} m at {max(e.max_reach for e in links):.3g} m reach"
+              if largest > tolerance.position else "")
     lines.append(f"{'PASS' if passed else 'FAIL'}: max position error {max_position:.3g} m (tolerance "
-                 f"{tolerance.position:g}), max orientation error {max_orientation:.3g} rad (tolerance "
+                 f"{tolerance.describe()}{scaled}), max orientation error {max_orientation:.3g} rad (tolerance "
                  f"{tolerance.orientation:g}); {samples} samples, seed {seed}")
     return Report(data=data, tables=[link_table, *([dh.table] if dh else [])], lines=lines, ok=passed)
 
