@@ -219,3 +219,69 @@ def test_bodies_beyond_pybullets_state_limits_are_refused(session, write_urdf, j
 def test_names_that_crash_pybullet_are_refused(session, write_urdf):
     with pytest.raises(UserError, match="1500 characters long"):
         session.load(load_model(write_urdf(_chain(1, robot_name="x" * 1500))))
+
+
+PLY_TRIANGLE = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                "element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+PLY_ROBOT = """<?xml version="1.0"?>
+<!-- comments and blank lines: the loadable copy (indented, without them) has other line numbers -->
+<robot name="ply">
+
+  <!-- the base -->
+  <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <visual><origin xyz="0 0 0"/><geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>
+
+
+  <link name="tip"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <collision><geometry><mesh filename="tri.ply"/></geometry></collision></link>
+  <joint name="j" type="revolute"><parent link="base"/><child link="tip"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/></joint>
+</robot>
+"""
+
+
+def _quoted_line(message: str, path) -> int:
+    """The line number ``message`` quotes for ``path`` (``PATH:LINE:``)."""
+    head = f"{path}:"
+    assert head in message, message
+    return int(message.split(head, 1)[1].split(":", 1)[0])
+
+
+@pytest.mark.parametrize("visuals", [True, False])
+def test_load_error_quotes_the_line_of_the_users_file(session, write_urdf, visuals):
+    """pybullet names lines of the loadable copy; the user sees the line of their file holding the '.ply'."""
+    path = write_urdf(PLY_ROBOT, "ply.urdf")
+    (path.parent / "tri.ply").write_text(PLY_TRIANGLE)
+    with pytest.raises(UserError) as caught:
+        session.load(load_model(path), visuals=visuals)
+    message = caught.value.message
+    assert "invalid mesh filename extension '.ply'" in message
+    line = _quoted_line(message.split("cannot load it: ", 1)[1], path)
+    assert ".ply" in PLY_ROBOT.splitlines()[line - 1]
+
+
+def test_load_error_quotes_the_line_of_the_xacro_source(session, tmp_path):
+    """Through xacro's origins: the line of the .xacro that wrote the <mesh>, not of the expansion or the copy."""
+    source = textwrap.dedent("""\
+        <?xml version="1.0"?>
+        <robot name="ply" xmlns:xacro="http://www.ros.org/wiki/xacro">
+          <xacro:property name="unit" value="0.01"/>
+          <xacro:macro name="part" params="name">
+            <link name="${name}">
+              <inertial><mass value="1"/><inertia ixx="${unit}" ixy="0" ixz="0" iyy="${unit}" iyz="0" izz="${unit}"/></inertial>
+
+              <collision><geometry><mesh filename="tri.ply"/></geometry></collision>
+            </link>
+          </xacro:macro>
+          <link name="base"/>
+          <xacro:part name="tip"/>
+          <joint name="j" type="fixed"><parent link="base"/><child link="tip"/></joint>
+        </robot>
+        """)
+    path = tmp_path / "ply.urdf.xacro"
+    path.write_text(source)
+    (tmp_path / "tri.ply").write_text(PLY_TRIANGLE)
+    with pytest.raises(UserError) as caught:
+        session.load(load_model(path))
+    line = _quoted_line(caught.value.message.split("cannot load it: ", 1)[1], path)
+    assert "tri.ply" in source.splitlines()[line - 1]

@@ -17,15 +17,19 @@ pybullet in three measured ways (``docs/pybullet-facts.md``, sections 7 and 10):
 
 Only the ``<link>`` elements move (into the slots links held before); joints and everything else
 stay where they were. Names and geometry are untouched, so every command's link naming is the
-file's.
+file's. Line numbers are not: pybullet quotes lines of the copy ("invalid mesh filename extension"),
+so :func:`loadable_document` can fill a line map (copy line -> the user's file and line, through
+xacro's origins for a xacro) and :func:`user_lines` rewrites pybullet's messages with it.
 """
 
 from __future__ import annotations
 
+import bisect
 import copy
+import re
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 from ar3cli.urdf.model import Model
 
@@ -34,12 +38,23 @@ UNNAMED_ROBOT = "robot"
 pybullet refuses to load it, and the name is used for nothing else."""
 
 
-def loadable_document(model: Model, visuals: bool = True) -> bytes:
+class Place(NamedTuple):
+    """A line of the user's file (the xacro source, or a file it includes, for a xacro)."""
+
+    file: str
+    line: int
+
+
+LineMap = dict[int, Place]
+"""Line of the loadable copy -> where the element starting on it was written."""
+
+
+def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None = None) -> bytes:
     """The bytes of the copy pybullet loads: absolute mesh paths, links parent-first, indented.
 
     ``visuals=False`` leaves the ``<visual>`` elements out, for work that never draws: reading the
     visual meshes is most of a load (measured on pybullet_data's panda: 0.09-0.30 s with them,
-    0.014-0.028 s without).
+    0.014-0.028 s without). ``lines``, when given, is filled with the copy's :data:`LineMap`.
     """
     from lxml import etree
 
@@ -58,13 +73,78 @@ def loadable_document(model: Model, visuals: bool = True) -> bytes:
         resolution = model.resolver.resolve(uri)
         if resolution.found:
             element.set("filename", str(resolution.path))
-    return etree.tostring(root, xml_declaration=True, encoding="utf-8")
+    document = etree.tostring(root, xml_declaration=True, encoding="utf-8")
+    if lines is not None:
+        lines.update(line_map(model, root, document))
+    return document
 
 
-def write_loadable_copy(model: Model, path: Path, visuals: bool = True) -> Path:
-    """Write :func:`loadable_document` to ``path`` and return it."""
-    path.write_bytes(loadable_document(model, visuals))
+def write_loadable_copy(model: Model, path: Path, visuals: bool = True, lines: LineMap | None = None) -> Path:
+    """Write :func:`loadable_document` to ``path`` (filling ``lines``) and return it."""
+    path.write_bytes(loadable_document(model, visuals, lines))
     return path
+
+
+def line_map(model: Model, copied: Any, document: bytes) -> LineMap:
+    """Each line of ``document`` that starts an element -> where that element was written.
+
+    ``copied`` is the tree ``document`` serialises: deep copies keep their original ``sourceline``
+    (lxml copies it), and the serialised document re-parsed has the same elements in the same
+    order, so walking both side by side pairs each copy line with its line in the user's text. For a
+    xacro that text is the expansion, whose lines are mapped on to the xacro source by xacro's
+    recorded origins (an element xacro made itself keeps the expansion's nearest known line).
+    """
+    from lxml import etree
+
+    source = _expansion_places(model)
+    shown = str(model.path)
+    result: LineMap = {}
+    reparsed = etree.fromstring(document, etree.XMLParser(huge_tree=True))
+    for written, original in zip(_elements(reparsed), _elements(copied)):
+        if written.sourceline and original.sourceline and written.sourceline not in result:
+            place = source.get(original.sourceline) if source is not None else Place(shown, original.sourceline)
+            if place is not None:
+                result[written.sourceline] = place
+    return result
+
+
+def _elements(root: Any) -> list[Any]:
+    return [node for node in root.iter() if isinstance(node.tag, str)]
+
+
+def _expansion_places(model: Model) -> dict[int, Place] | None:
+    """For a xacro: line of the expansion -> the xacro file and line its first element came from (None for a URDF)."""
+    if not model.is_xacro:
+        return None
+    from ar3cli.urdf.xacro_expand import origins
+
+    found = origins(model.xml_bytes) or []
+    elements = _elements(model.root)
+    places: dict[int, Place] = {}
+    if len(found) == len(elements):
+        for element, origin in zip(elements, found):
+            if origin is not None and element.sourceline and element.sourceline not in places:
+                places[element.sourceline] = Place(origin.file, origin.line)
+    return places
+
+
+def user_lines(message: str, copy_path: Path, lines: LineMap, shown: str) -> str:
+    """``message`` with every ``COPY:LINE`` pybullet wrote turned into ``FILE:LINE`` of the user's file.
+
+    A line that starts no element (a closing tag) takes the nearest element line above it; the copy's
+    name without a known line becomes ``shown`` (the user's path), so no line of the copy is ever shown.
+    """
+    known = sorted(lines)
+
+    def place(match: re.Match) -> str:
+        at = bisect.bisect_right(known, int(match.group(1))) - 1
+        if at < 0:
+            return shown
+        found = lines[known[at]]
+        return f"{found.file}:{found.line}"
+
+    message = re.sub(re.escape(str(copy_path)) + r":(\d+)", place, message)
+    return message.replace(str(copy_path), shown)
 
 
 def parent_first_order(names: list[str], edges: Iterable[tuple[str | None, str | None]]) -> list[str]:

@@ -42,6 +42,7 @@ from typing import Any, TypeVar
 from ar3cli.errors import UserError
 from ar3cli.infra.isolation import report_stage
 from ar3cli.sim.capture import capture_fds
+from ar3cli.sim.loadable_copy import LineMap, user_lines
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 Result = TypeVar("Result")
@@ -346,7 +347,8 @@ class Session:
             flags |= p.URDF_USE_SELF_COLLISION | p.URDF_USE_SELF_COLLISION_INCLUDE_PARENT
         elif self_collision == SELF_COLLISION_DEFAULT:
             flags |= p.URDF_USE_SELF_COLLISION
-        urdf_path = self._write_loadable_copy(model, visuals)
+        lines: LineMap = {}
+        urdf_path = self._write_loadable_copy(model, visuals, lines)
         report_stage("loading it")
         with capture_fds() as captured:
             try:
@@ -355,7 +357,7 @@ class Session:
                                      useMaximalCoordinates=maximal_coordinates, physicsClientId=self.client)
             except p.error:
                 body_id = -1
-        messages = [message.replace(str(urdf_path), str(model.path)) for message in captured.messages]
+        messages = [user_lines(message, urdf_path, lines, str(model.path)) for message in captured.messages]
         self.messages.extend(messages)
         if body_id < 0:
             raise UserError(f"{model.path}: pybullet cannot load it: {load_failure_reason(model, messages)}")
@@ -376,12 +378,12 @@ class Session:
                             "simulation of it can be trusted; see ar3cli lint-urdf")
         return body
 
-    def _write_loadable_copy(self, model: Model, visuals: bool = True) -> Path:
-        """Write the copy pybullet loads (:mod:`ar3cli.sim.loadable_copy`) under a fresh name."""
+    def _write_loadable_copy(self, model: Model, visuals: bool = True, lines: LineMap | None = None) -> Path:
+        """Write the copy pybullet loads (:mod:`ar3cli.sim.loadable_copy`) under a fresh name, filling ``lines``."""
         from ar3cli.sim.loadable_copy import write_loadable_copy
 
         name = f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
-        return write_loadable_copy(model, Path(self._tmp.name) / name, visuals)
+        return write_loadable_copy(model, Path(self._tmp.name) / name, visuals, lines)
 
     def step(self, count: int = 1) -> None:
         for _ in range(count):
