@@ -285,3 +285,29 @@ def test_load_error_quotes_the_line_of_the_xacro_source(session, tmp_path):
         session.load(load_model(path))
     line = _quoted_line(caught.value.message.split("cannot load it: ", 1)[1], path)
     assert "tri.ply" in source.splitlines()[line - 1]
+
+
+@pytest.mark.parametrize("inside, reason, marker", [
+    ('<inertial><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>',
+     "its <inertial> has no <mass> (lint-urdf I003)", "<inertial>"),
+    ('<collision>\n      <origin xyz="0 0 0"/>\n    </collision>', "a <collision> has no <geometry>", "<collision>"),
+    ('<visual><geometry>\n      <mesh/></geometry></visual>', "the <mesh> of a <visual> has no filename attribute", "<mesh/>"),
+])
+def test_failed_to_parse_link_names_the_link_the_line_and_the_reason(session, write_urdf, inside, reason, marker):
+    """pybullet says only "failed to parse link"; ar3cli finds the culprit in the file (the line holding it)."""
+    text = f"""<?xml version="1.0"?>
+<robot name="r">
+  <link name="base"/>
+
+  <link name="tip">
+    {inside}
+  </link>
+  <joint name="j" type="fixed"><parent link="base"/><child link="tip"/></joint>
+</robot>
+"""
+    path = write_urdf(text)
+    with pytest.raises(UserError) as caught:
+        session.load(load_model(path))
+    message = caught.value.message
+    assert f"link 'tip' ({path}:" in message and message.endswith(reason), message
+    assert marker in text.splitlines()[_quoted_line(message.split("cannot load it: ", 1)[1], path) - 1]

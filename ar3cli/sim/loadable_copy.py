@@ -128,6 +128,15 @@ def _expansion_places(model: Model) -> dict[int, Place] | None:
     return places
 
 
+def user_place(model: Model, element: Any) -> Place | None:
+    """Where ``element`` of ``model.root`` was written: the file and line the user sees (None if unknown)."""
+    line = element.sourceline
+    if not line:
+        return None
+    places = _expansion_places(model)
+    return Place(str(model.path), line) if places is None else places.get(line)
+
+
 def user_lines(message: str, copy_path: Path, lines: LineMap, shown: str) -> str:
     """``message`` with every ``COPY:LINE`` pybullet wrote turned into ``FILE:LINE`` of the user's file.
 

@@ -446,6 +446,12 @@ def load_failure_reason(model: Model, messages: list[str]) -> str:
         resolution = shape.geometry.resolution
         if resolution is not None and not resolution.found:
             return f"mesh {resolution.explain()}"
+    if any("failed to parse link" in message for message in messages):
+        from ar3cli.sim.load_culprit import link_culprit
+
+        culprit = link_culprit(model)
+        if culprit is not None:
+            return culprit
     interesting = [m for m in messages if not m.startswith("No inertial data")]
     for keyword in ("cannot find", "invalid mesh", "does not specify limits", "Cannot", "cannot", "failed"):
         for message in interesting:
