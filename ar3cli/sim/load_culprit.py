@@ -16,7 +16,7 @@ from typing import Any
 from ar3cli.urdf.model import Model
 
 SHAPE_ATTRIBUTES = {"box": ("size",), "sphere": ("radius",), "cylinder": ("length", "radius"),
-                    "capsule": ("length", "radius"), "mesh": ("filename",), "plane": ()}
+                    "capsule": ("length", "radius"), "mesh": ("filename",), "plane": (), "cdf": ("filename",)}
 """The shapes pybullet's URDF parser knows, with the attributes it refuses to go without."""
 INERTIA_ATTRIBUTES = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
 
