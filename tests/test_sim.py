@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import re
 import textwrap
 
 import pytest
@@ -244,7 +245,7 @@ def _quoted_line(message: str, path) -> int:
     """The line number ``message`` quotes for ``path`` (``PATH:LINE:``)."""
     head = f"{path}:"
     assert head in message, message
-    return int(message.split(head, 1)[1].split(":", 1)[0])
+    return int(re.match(r"\d+", message.split(head, 1)[1]).group())
 
 
 @pytest.mark.parametrize("visuals", [True, False])
