@@ -51,3 +51,41 @@ def test_bad_config_is_one_line_error(cli, tmp_path):
     assert result.code == 2 and "finite" in result.stderr and not (tmp_path / "x.png").exists()
     result = cli("render", AR3, "-o", str(tmp_path / "missing" / "x.png"))
     assert result.code == 2 and "does not exist" in result.stderr and not (tmp_path / "missing").exists()
+
+
+def _robot_with_visuals(base_visual: str, tip_visual: str) -> str:
+    inertial = '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
+    box = '<geometry><box size="0.2 0.2 0.2"/></geometry>'
+    return (f'<robot name="r"><link name="base">{inertial}<visual>{base_visual}</visual><collision>{box}</collision></link>'
+            f'<link name="tip">{inertial}<visual>{tip_visual}</visual></link>'
+            '<joint name="j" type="revolute"><parent link="base"/><child link="tip"/><origin xyz="0 0 0.5"/>'
+            '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint></robot>')
+
+
+def test_an_unloadable_visual_is_replaced_with_a_warning_and_the_picture_made(cli, write_urdf, tmp_path):
+    """A .glb visual on the base (pybullet refuses it) and a missing visual mesh on the tip: the base is drawn
+    by its collision box, the tip is left out, one warning line each on stderr, exit 0."""
+    (tmp_path / "base.glb").write_bytes(b"glTF")
+    path = write_urdf(_robot_with_visuals('<geometry><mesh filename="base.glb"/></geometry>',
+                                          '<geometry><mesh filename="missing.stl"/></geometry>'))
+    out = tmp_path / "r.png"
+    result = cli("render", str(path), "-o", str(out), "--width", "64", "--height", "48", "--format", "json")
+    assert result.code == 0, result.stderr
+    assert out.exists() and json.loads(result.stdout)
+    warnings = [line for line in result.stderr.splitlines() if "render: warning" in line]
+    assert len(warnings) == 2
+    assert "link 'base'" in warnings[0] and "'.glb'" in warnings[0] and "collision shape instead" in warnings[0]
+    assert "link 'tip'" in warnings[1] and "missing.stl" in warnings[1] and "left out" in warnings[1]
+
+
+def test_nothing_drawable_is_an_error_suggesting_collision(cli, write_urdf, tmp_path):
+    path = write_urdf(_robot_with_visuals('<geometry><mesh filename="gone.stl"/></geometry>',
+                                          '<geometry><mesh filename="gone.stl"/></geometry>').replace(
+        '<collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision>', ""))
+    result = cli("render", str(path), "-o", str(tmp_path / "r.png"), "--width", "64", "--height", "48")
+    assert result.code == 2 and result.stderr.count("ar3cli: error:") == 1
+    assert "no visual geometry can be drawn" in result.stderr
+    suggests = cli("render", str(write_urdf(_robot_with_visuals('<geometry><mesh filename="gone.stl"/></geometry>',
+                                                                '<geometry><mesh filename="gone.stl"/></geometry>'))),
+                   "-o", str(tmp_path / "r.png"), "--width", "64", "--height", "48")
+    assert suggests.code == 0  # the base's collision box is drawn instead

@@ -79,6 +79,63 @@ def showing_collision_geometry(model: Model) -> Model:
     return overlay
 
 
+DRAWABLE_MESH_FORMATS = (".stl", ".obj", ".dae")
+"""What pybullet loads as a visual mesh (lint-urdf's G004): anything else makes it refuse the whole file."""
+
+
+def undrawable_reason(shape: Any) -> str | None:
+    """Why pybullet cannot load ``shape`` (a model Shape) as a mesh: not found, or a format it does not read."""
+    geometry = shape.geometry
+    if geometry.kind != "mesh":
+        return None
+    resolution = geometry.resolution
+    if resolution is not None and not resolution.found:
+        return f"mesh {resolution.explain()}"
+    suffix = Path((geometry.filename or "").strip()).suffix.lower()
+    if suffix not in DRAWABLE_MESH_FORMATS:
+        return f"pybullet cannot load '{suffix or 'no extension'}' meshes ({geometry.filename})"
+    return None
+
+
+def drawable_visuals(model: Model) -> tuple[Model, list[str]]:
+    """``model``, or a copy whose visuals pybullet cannot load are replaced, and one warning per replacement.
+
+    One unloadable visual (a ``.glb``, a missing mesh) makes pybullet refuse the whole robot, while
+    everything else could be drawn: the visual is taken out and its link shows its collision shapes
+    instead (in the collision colour), or nothing when they cannot be drawn either.
+    """
+    from lxml import etree
+
+    from ar3cli.sim.loadable_copy import user_place
+
+    broken = [(link, shape, reason) for link in model.links for shape in link.visuals
+              if (reason := undrawable_reason(shape)) is not None]
+    if not broken:
+        return model, []
+    root = copy.deepcopy(model.root)
+    twin = dict(zip(model.root.iter(), root.iter()))
+    warnings, replaced = [], set()
+    for link, shape, reason in broken:
+        twin[shape.element].getparent().remove(twin[shape.element])
+        drawable = [c for c in link.collisions if undrawable_reason(c) is None and c.element.find("geometry") is not None]
+        if drawable and link.name not in replaced:
+            replaced.add(link.name)
+            for collision in drawable:
+                visual = etree.SubElement(twin[link.element], "visual")
+                for child in collision.element:
+                    if child.tag in ("origin", "geometry"):
+                        visual.append(copy.deepcopy(child))
+                material = etree.SubElement(visual, "material", name="ar3cli_collision_geometry")
+                etree.SubElement(material, "color", rgba=COLLISION_RGBA)
+        instead = "drawn as its collision shape instead" if drawable else "left out"
+        place = user_place(model, shape.element)
+        where = f" ({place.file}:{place.line})" if place is not None else ""
+        warnings.append(f"render: warning: link '{link.name}'{where}: a visual cannot be drawn ({reason}); {instead}")
+    overlay = copy.copy(model)
+    overlay.root = root
+    return overlay, warnings
+
+
 def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | None = None,
            width: int = 800, height: int = 600, yaw_deg: float = 45.0, pitch_deg: float = -20.0,
            show_collision: bool = False, show_contacts: bool = True) -> RenderResult:
@@ -91,8 +148,19 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
         raise UserError(f"image size {width}x{height} is out of range (16..4096 pixels per side)")
     if not output.parent.is_dir():
         raise UserError(f"-o {output}: folder {output.parent} does not exist")
+    shown = model
+    if not show_collision:
+        from ar3cli.output.report import log
+
+        shown, warnings = drawable_visuals(model)
+        for warning in warnings:
+            log(warning)
+        if warnings and shown.root.find("link/visual") is None:
+            collision = any(link.collisions for link in model.links)
+            raise UserError(f"{model.path}: no visual geometry can be drawn ({len(warnings)} visual(s) left out, see the "
+                            "warnings above); " + ("try --collision" if collision else "no link has <collision> either"))
     rgb, values, contacts = run_pybullet(
-        lambda: _draw(model, configuration or {}, width, height, yaw_deg, pitch_deg, show_collision, show_contacts),
+        lambda: _draw(shown, configuration or {}, width, height, yaw_deg, pitch_deg, show_collision, show_contacts),
         model)
     if picture_is_empty(rgb):
         raise UserError(f"{model.path}: the picture shows no robot: {_why_nothing_shows(model, show_collision)}")
