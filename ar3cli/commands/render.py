@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
-from ar3cli.output.report import OutputFormat, Report, Table, finish
+from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 from ar3cli.urdf.loading import load_with_specs
 
 
@@ -37,7 +37,7 @@ def render_command(
     configuration = parse_configuration(config)
     model = load_with_specs(path, package_path, xacro_arg)
     result = draw_robot(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
-                  show_collision=collision)
+                  show_collision=collision, warn=log)
     tables = []
     if result.contacts:
         tables.append(Table(title="links in contact (drawn red)", columns=["link a", "link b", "depth (m)"],

@@ -13,7 +13,7 @@ from __future__ import annotations
 import copy
 import io
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -138,8 +138,12 @@ def drawable_visuals(model: Model) -> tuple[Model, list[str]]:
 
 def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | None = None,
            width: int = 800, height: int = 600, yaw_deg: float = 45.0, pitch_deg: float = -20.0,
-           show_collision: bool = False, show_contacts: bool = True) -> RenderResult:
-    """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``."""
+           show_collision: bool = False, show_contacts: bool = True,
+           warn: Callable[[str], None] | None = None) -> RenderResult:
+    """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``.
+
+    ``warn`` receives one line per visual that could not be drawn (:func:`drawable_visuals`).
+    """
     from PIL import Image
 
     from ar3cli.sim.session import run_pybullet
@@ -150,11 +154,9 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
         raise UserError(f"-o {output}: folder {output.parent} does not exist")
     shown = model
     if not show_collision:
-        from ar3cli.output.report import log
-
         shown, warnings = drawable_visuals(model)
-        for warning in warnings:
-            log(warning)
+        for warning in warnings if warn is not None else ():
+            warn(warning)
         if warnings and shown.root.find("link/visual") is None:
             collision = any(link.collisions for link in model.links)
             raise UserError(f"{model.path}: no visual geometry can be drawn ({len(warnings)} visual(s) left out, see the "
