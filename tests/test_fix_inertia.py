@@ -434,3 +434,20 @@ def test_the_fixer_says_what_lint_still_finds_after_the_fix(cli, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.urdf"]
     text = cli("fix-inertia", str(path), "--density", "1200", "--diff")
     assert "after the fix, ar3cli lint-urdf" in text.stderr + text.stdout
+
+
+def test_collada_unit_gives_the_volume_in_metres(cli, tmp_path):
+    """cube_inches.dae is a 6-unit cube in inches: 0.1524 m a side, 3.54 kg at 1000 kg/m3 (not 216 t)."""
+    (tmp_path / "cube_inches.dae").write_bytes((Path(__file__).parent / "data" / "meshes" / "cube_inches.dae").read_bytes())
+    path = write(tmp_path / "inch.urdf", """<?xml version="1.0"?>
+<robot name="inch"><link name="part"><collision><geometry><mesh filename="cube_inches.dae"/></geometry></collision></link></robot>
+""")
+    result = cli("fix-inertia", str(path), "--links", "part", "--density", "1000", "--format", "json")
+    assert result.code == 0, result.stdout + result.stderr
+    mass, com, tensor = inertial_of(path, "part")
+    side = 6 * 0.0254
+    assert mass == pytest.approx(1000 * side ** 3, rel=1e-6)
+    assert com == pytest.approx([side / 2] * 3, rel=1e-6)
+    assert tensor[0, 0] == pytest.approx(mass * side ** 2 / 6, rel=1e-6)
+    sources = {c["source"] for c in json.loads(result.stdout)["files"][0]["changes"]}
+    assert any("COLLADA unit 0.0254 m" in source for source in sources)

@@ -508,3 +508,28 @@ def test_only_the_exact_idiom_pairs_are_pybullets(tmp_path, lower, upper, code):
     text = arm(joint_type="prismatic", joint_extra=f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/>')
     path = write_fixture(tmp_path, text)
     assert len(codes_for(path, code)) == 1 and codes_for(path, {"J003": "J014", "J014": "J003"}[code]) == []
+
+
+# ---- COLLADA <unit meter> in the boxes every size rule uses (issue 30 item 16) ----------------------
+
+def _inch_cube_link(tmp_path: Path, inertial: str) -> Path:
+    """A link whose collision is tests/data/meshes/cube_inches.dae: 6 units of 0.0254 m, a 15.24 cm cube."""
+    return write_fixture(tmp_path, robot(f'<link name="part">{inertial}<collision><geometry>'
+                                         '<mesh filename="cube_inches.dae"/></geometry></collision></link>'),
+                         files={"cube_inches.dae": (MESHES / "cube_inches.dae").read_bytes()})
+
+
+def test_collada_unit_is_applied_to_link_bounds(tmp_path):
+    from ar3cli.urdf.bounds import link_bounds, scaled_mesh_bounds
+    from ar3cli.urdf.model import load_model
+
+    link = load_model(_inch_cube_link(tmp_path, LINK_INERTIAL)).link("part")
+    low, high = link_bounds(link)
+    assert low == (0.0, 0.0, 0.0) and high == pytest.approx((0.1524,) * 3, rel=1e-9)
+    assert scaled_mesh_bounds(link.collisions[0].geometry)[1] == pytest.approx((6.0,) * 3)  # file units, for G006
+
+
+def test_implausible_inertia_is_judged_in_metres_for_an_inch_mesh(tmp_path):
+    """I = 1 kg·m² on 1 kg: a radius of gyration of 1 m, 7x a 15 cm cube (but not 6 m, the size in file units)."""
+    (finding,) = codes_for(_inch_cube_link(tmp_path, tensor(1, 1, 1)), "I007")
+    assert "half-diagonal 0.132 m" in finding.message
