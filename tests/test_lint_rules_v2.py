@@ -533,3 +533,17 @@ def test_implausible_inertia_is_judged_in_metres_for_an_inch_mesh(tmp_path):
     """I = 1 kg·m² on 1 kg: a radius of gyration of 1 m, 7x a 15 cm cube (but not 6 m, the size in file units)."""
     (finding,) = codes_for(_inch_cube_link(tmp_path, tensor(1, 1, 1)), "I007")
     assert "half-diagonal 0.132 m" in finding.message
+
+
+# ---- --fix-hint asks for a mass source only where fix-inertia needs one (issue 30 item 13) ----------
+
+def test_fix_hint_asks_no_density_for_frame_links(tmp_path):
+    from ar3cli.lint.fix_hints import fix_commands
+
+    frame_only = findings(write_fixture(tmp_path / "frame", fixed_child("")))
+    assert [f.rule for f in frame_only if f.rule.startswith("I")] == ["I002"]
+    assert fix_commands("robot.urdf", frame_only) == ["ar3cli fix-inertia robot.urdf  # I002"]
+    part = findings(write_fixture(tmp_path / "part", fixed_child(
+        '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>')))
+    assert fix_commands("robot.urdf", [f for f in part if f.rule == "I002"]) == [
+        "ar3cli fix-inertia robot.urdf --density KG_PER_M3  # I002"]
