@@ -434,3 +434,50 @@ def test_the_fixer_says_what_lint_still_finds_after_the_fix(cli, tmp_path):
     assert sorted(p.name for p in tmp_path.iterdir()) == ["arm.urdf"]
     text = cli("fix-inertia", str(path), "--density", "1200", "--diff")
     assert "after the fix, ar3cli lint-urdf" in text.stderr + text.stdout
+
+
+def test_collada_unit_gives_the_volume_in_metres(cli, tmp_path):
+    """cube_inches.dae is a 6-unit cube in inches: 0.1524 m a side, 3.54 kg at 1000 kg/m3 (not 216 t)."""
+    (tmp_path / "cube_inches.dae").write_bytes((Path(__file__).parent / "data" / "meshes" / "cube_inches.dae").read_bytes())
+    path = write(tmp_path / "inch.urdf", """<?xml version="1.0"?>
+<robot name="inch"><link name="part"><collision><geometry><mesh filename="cube_inches.dae"/></geometry></collision></link></robot>
+""")
+    result = cli("fix-inertia", str(path), "--links", "part", "--density", "1000", "--format", "json")
+    assert result.code == 0, result.stdout + result.stderr
+    mass, com, tensor = inertial_of(path, "part")
+    side = 6 * 0.0254
+    assert mass == pytest.approx(1000 * side ** 3, rel=1e-6)
+    assert com == pytest.approx([side / 2] * 3, rel=1e-6)
+    assert tensor[0, 0] == pytest.approx(mass * side ** 2 / 6, rel=1e-6)
+    sources = {c["source"] for c in json.loads(result.stdout)["files"][0]["changes"]}
+    assert any("COLLADA unit 0.0254 m" in source for source in sources)
+
+
+# ---- issue 30 item 13: --total-mass goes to physical parts, not to visual-only markers -------------
+MARKER_ROBOT = Path(__file__).parent / "data" / "inertia" / "base_with_marker.urdf"
+
+
+def test_total_mass_skips_visual_only_markers_and_says_so(cli, tmp_path):
+    path = write(tmp_path / "robot.urdf", MARKER_ROBOT.read_text())
+    result = cli("fix-inertia", str(path), "--total-mass", "10", "--format", "json")
+    assert result.code == 1, result.stdout + result.stderr  # the marker is reported as not fixed
+    file = json.loads(result.stdout)["files"][0]
+    body, wheel = (inertial_of(path, name)[0] for name in ("body", "wheel"))
+    assert body + wheel == pytest.approx(10.0, rel=1e-9)
+    assert body / wheel == pytest.approx(0.4 * 0.3 * 0.1 / (np.pi * 0.1 ** 2 * 0.05), rel=1e-9)
+    assert load_model(path).link("ee_marker").inertial is None
+    (skipped,) = file["skipped"]
+    assert skipped["element"] == "link ee_marker <inertial>" and "visual geometry only" in skipped["reason"]
+    assert "--mass ee_marker=KG" in skipped["reason"]
+    (note,) = [n for n in file["notes"] if n.startswith("--total-mass")]
+    assert "body 88.4%, wheel 11.6%" in note and "left out (visual geometry only, no <collision>): ee_marker" in note
+    assert inertial_of(path, "imu_link")[0] == 1e-6  # the frame link needs no mass source
+
+
+def test_total_mass_names_unselected_massless_parts(cli, tmp_path):
+    text = MARKER_ROBOT.read_text().replace('<link name="world"/>', "")
+    text = text[:text.index('  <joint name="world_to_body"')] + text[text.index('  <joint name="wheel_joint"'):]
+    path = write(tmp_path / "robot.urdf", text)  # body is now the root: I012 (info), which fix-inertia does not fix
+    result = cli("fix-inertia", str(path), "--total-mass", "10", "--format", "json")
+    (note,) = [n for n in json.loads(result.stdout)["files"][0]["notes"] if n.startswith("--total-mass")]
+    assert "wheel 100.0%" in note and "not selected, and weighing nothing in the file: body" in note

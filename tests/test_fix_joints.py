@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 
 from ar3cli.urdf.model import load_model
-from tests.conftest import ASSETS
+from tests.conftest import ASSETS, REPO
 from tests.fixer_helpers import element_lines, lint_findings, only_within
 
 INERTIAL = '<inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>'
@@ -149,3 +149,35 @@ def test_clean_file_nothing_to_do(cli, tmp_path):
     path.write_bytes((ASSETS / "ar3" / "ar3.urdf").read_bytes())
     result = cli("fix-joints", str(path), "--format", "json")
     assert result.code == 0 and json.loads(result.stdout)["files"][0]["changes"] == []
+
+
+# ---- issue 30: floating bases and PyBullet's "no limit" idiom are not defects to convert ----------
+JOINT_DATA = REPO / "tests" / "data" / "joints"
+
+
+def test_floating_hand_virtual_joints_are_not_converted(cli, write_urdf):
+    """Six virtual base joints share -20..20 (metres on the prismatic ones): only the finger's degrees change."""
+    text = (JOINT_DATA / "floating_hand.urdf").read_text()
+    path = write_urdf(text)
+    result = cli("fix-joints", str(path), "--format", "json")
+    assert result.code == 0, result.stdout + result.stderr
+    (file,) = json.loads(result.stdout)["files"]
+    assert {(c["element"], c["field"], c["new"]) for c in file["changes"]} == {
+        ("joint finger_joint", "limit upper", "1.570796327")}
+    fixed = path.read_text()
+    assert fixed == text.replace('lower="0" upper="90"', 'lower="0" upper="1.570796327"')
+    assert fixed.count('lower="-20" upper="20"') == 6
+
+
+def test_pybullet_no_limit_idiom_is_left_alone_and_named(cli, write_urdf):
+    text = (JOINT_DATA / "pybullet_unlimited.urdf").read_text()
+    path = write_urdf(text)
+    result = cli("fix-joints", str(path), "--format", "json")
+    assert result.code == 0, result.stdout + result.stderr
+    (file,) = json.loads(result.stdout)["files"]
+    assert {(c["element"], c["field"]) for c in file["changes"]} == {
+        ("joint shoulder", "limit lower"), ("joint shoulder", "limit upper")}
+    assert path.read_text() == text.replace('lower="1.2" upper="-0.8"', 'lower="-0.8" upper="1.2"')
+    (idiom,) = [note for note in file["notes"] if "alone: lower > upper" in note]
+    assert "x_to_world, z_to_x" in idiom and "J014" in idiom
+    assert file["verification"]["verified"] is True

@@ -453,3 +453,97 @@ def test_metadata_reaches_the_docs_and_the_rule_object():
     assert REGISTRY["J006"].fixed_by == "fix-continuous"
     codes = [r.code for r in RULES]
     assert codes == sorted(codes, key=lambda c: ("FSJIGP".index(c[0]), c))
+
+
+# ---- J005 and J003/J014 on virtual base joints and PyBullet's "no limit" idiom (issue 30) ----------
+JOINT_DATA = Path(__file__).parent / "data" / "joints"
+
+
+def _hand(massive_dummies: bool = False, prismatic_range: str = "-20 20") -> str:
+    """The floating hand fixture, with heavier dummy links or other prismatic limits."""
+    text = (JOINT_DATA / "floating_hand.urdf").read_text()
+    if massive_dummies:
+        for name in ("dummy_x", "dummy_y", "dummy_z", "dummy_ry"):
+            text = text.replace(f'<link name="{name}"/>', f'<link name="{name}">{tensor(0.01, 0.01, 0.01, 0.5)}</link>')
+    lower, upper = prismatic_range.split()
+    for axis in "xyz":
+        start = text.index(f'<joint name="virtual_{axis}"')
+        end = text.index("</joint>", start)
+        text = text[:start] + text[start:end].replace('lower="-20" upper="20"', f'lower="{lower}" upper="{upper}"') \
+            + text[end:]
+    return text
+
+
+@pytest.mark.parametrize("massive_dummies,prismatic_range", [(False, "-20 20"), (True, "-20 20"), (False, "-1 1")],
+                         ids=["both-kinds-of-evidence", "shared-range-only", "massless-chain-only"])
+def test_virtual_base_joints_are_not_degrees(tmp_path, massive_dummies, prismatic_range):
+    text = _hand(massive_dummies, prismatic_range)
+    (finding,) = codes_for(write_fixture(tmp_path, text), "J005")
+    assert "'finger_joint'" in finding.message  # the real degree typo of the same hand is still reported
+
+
+def test_heavy_dummies_with_other_ranges_are_judged_as_usual(tmp_path):
+    """Neither shared limits nor a massless chain: nothing says 'virtual', so ±20 still looks like degrees."""
+    reported = codes_for(write_fixture(tmp_path, _hand(True, "-1 1")), "J005")
+    assert sorted(f.message.split("'")[1] for f in reported) == ["finger_joint", "virtual_rx", "virtual_ry", "virtual_rz"]
+
+
+def test_first_joint_from_an_empty_root_is_still_judged(tmp_path):
+    """An empty root link alone (no moving joint between dummies) is no floating chain."""
+    text = arm(joint_extra='<limit lower="-170" upper="170" effort="10" velocity="1"/>')
+    assert len(codes_for(write_fixture(tmp_path, text), "J005")) == 1
+
+
+def test_pybullet_no_limit_idiom_is_explained_not_inverted(tmp_path):
+    path = write_fixture(tmp_path, (JOINT_DATA / "pybullet_unlimited.urdf").read_text())
+    (inverted,) = codes_for(path, "J003")
+    assert "'shoulder'" in inverted.message
+    idioms = codes_for(path, "J014")
+    assert [f.message.split("'")[1] for f in idioms] == ["x_to_world", "z_to_x"]
+    assert all(f.severity == Severity.INFO and "no limit" in f.message for f in idioms)
+
+
+@pytest.mark.parametrize("lower,upper,code", [(1, -1, "J014"), (0, -1, "J014"), (1.5, -1.5, "J003"), (2, -1, "J003")])
+def test_only_the_exact_idiom_pairs_are_pybullets(tmp_path, lower, upper, code):
+    text = arm(joint_type="prismatic", joint_extra=f'<limit lower="{lower}" upper="{upper}" effort="1" velocity="1"/>')
+    path = write_fixture(tmp_path, text)
+    assert len(codes_for(path, code)) == 1 and codes_for(path, {"J003": "J014", "J014": "J003"}[code]) == []
+
+
+# ---- COLLADA <unit meter> in the boxes every size rule uses (issue 30 item 16) ----------------------
+
+def _inch_cube_link(tmp_path: Path, inertial: str) -> Path:
+    """A link whose collision is tests/data/meshes/cube_inches.dae: 6 units of 0.0254 m, a 15.24 cm cube."""
+    return write_fixture(tmp_path, robot(f'<link name="part">{inertial}<collision><geometry>'
+                                         '<mesh filename="cube_inches.dae"/></geometry></collision></link>'),
+                         files={"cube_inches.dae": (MESHES / "cube_inches.dae").read_bytes()})
+
+
+def test_collada_unit_is_applied_to_link_bounds(tmp_path):
+    from ar3cli.urdf.bounds import link_bounds, scaled_mesh_bounds
+    from ar3cli.urdf.model import load_model
+
+    link = load_model(_inch_cube_link(tmp_path, LINK_INERTIAL)).link("part")
+    low, high = link_bounds(link)
+    assert low == (0.0, 0.0, 0.0) and high == pytest.approx((0.1524,) * 3, rel=1e-9)
+    assert scaled_mesh_bounds(link.collisions[0].geometry)[1] == pytest.approx((6.0,) * 3)  # file units, for G006
+
+
+def test_implausible_inertia_is_judged_in_metres_for_an_inch_mesh(tmp_path):
+    """I = 1 kg·m² on 1 kg: a radius of gyration of 1 m, 7x a 15 cm cube (but not 6 m, the size in file units)."""
+    (finding,) = codes_for(_inch_cube_link(tmp_path, tensor(1, 1, 1)), "I007")
+    assert "half-diagonal 0.132 m" in finding.message
+
+
+# ---- --fix-hint asks for a mass source only where fix-inertia needs one (issue 30 item 13) ----------
+
+def test_fix_hint_asks_no_density_for_frame_links(tmp_path):
+    from ar3cli.lint.fix_hints import fix_commands
+
+    frame_only = findings(write_fixture(tmp_path / "frame", fixed_child("")))
+    assert [f.rule for f in frame_only if f.rule.startswith("I")] == ["I002"]
+    assert fix_commands("robot.urdf", frame_only) == ["ar3cli fix-inertia robot.urdf  # I002"]
+    part = findings(write_fixture(tmp_path / "part", fixed_child(
+        '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>')))
+    assert fix_commands("robot.urdf", [f for f in part if f.rule == "I002"]) == [
+        "ar3cli fix-inertia robot.urdf --density KG_PER_M3  # I002"]

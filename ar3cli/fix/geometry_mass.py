@@ -1,8 +1,9 @@
 """Mass properties of a link from its geometry.
 
 Primitives use :mod:`ar3cli.physics.mass_properties` (exact, analytic). Meshes use trimesh: scale
-applied, exact signed-tetrahedra volume when the mesh is watertight, otherwise its convex hull
-with the hull/mesh volume ratio reported. Each shape's ``<origin>`` is applied and the shapes of
+and COLLADA ``<unit meter>`` applied (as PyBullet does; trimesh reads the unit but leaves it out),
+exact signed-tetrahedra volume when the mesh is watertight, otherwise its convex hull with the
+hull/mesh volume ratio reported. Each shape's ``<origin>`` is applied and the shapes of
 a link are combined with the parallel-axis theorem. Everything is computed at density 1 (so the
 ``mass`` field of a :class:`GeometryMass` is a volume in m^3) and scaled to a mass afterwards.
 
@@ -19,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ar3cli.physics import mass_properties as mp
+from ar3cli.urdf.bounds import mesh_unit
 from ar3cli.urdf.model import Link, Model, Shape
 
 FRAME_LINK_MASS = 1e-6
@@ -108,9 +110,13 @@ def mesh_mass(shape: Shape, cache: dict) -> tuple[mp.MassProperties, str]:
     scale = geometry.params.get("scale")
     if scale is None:
         raise GeometryError(f"mesh {geometry.filename!r} has a malformed scale")
-    key = (str(resolution.path), tuple(scale))
+    unit = mesh_unit(geometry)
+    if unit is None:
+        raise GeometryError(f"mesh {geometry.filename!r}: its COLLADA <unit meter> is not a positive number, "
+                            "so its size in metres is unknown")
+    key = (str(resolution.path), tuple(scale), unit)
     if key not in cache:
-        cache[key] = _mesh_mass_uncached(Path(resolution.path), tuple(scale))
+        cache[key] = _mesh_mass_uncached(Path(resolution.path), tuple(scale), unit)
     return cache[key]
 
 
@@ -129,11 +135,15 @@ def load_welded_mesh(path: Path):
     return mesh
 
 
-def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float]) -> tuple[mp.MassProperties, str]:
+def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float],
+                        unit: float = 1.0) -> tuple[mp.MassProperties, str]:
+    """``unit``: metres per file unit (a COLLADA ``<unit meter>``; trimesh reads it but does not apply it)."""
     mesh = load_welded_mesh(path)
-    if tuple(scale) != (1.0, 1.0, 1.0):
-        mesh.apply_transform(np.diag([*scale, 1.0]))
+    if tuple(scale) != (1.0, 1.0, 1.0) or unit != 1.0:
+        mesh.apply_transform(np.diag([*(s * unit for s in scale), 1.0]))
     scale_note = "" if tuple(scale) == (1.0, 1.0, 1.0) else f" scale {' '.join(_fmt(s) for s in scale)}"
+    if unit != 1.0:
+        scale_note += f" COLLADA unit {_fmt(unit)} m"
     watertight = mesh.is_watertight
     if watertight or is_closed(mesh):
         if mesh.volume < 0:

@@ -8,8 +8,12 @@ deliberate placeholder; it is left alone and reported, unless ``--include-implau
 
 Mass source, always explicit (first that applies): ``--mass LINK=KG``; a valid (finite, > 0)
 mass already in the file; ``--density``; ``--total-mass`` (the robot's total: the masses kept
-above are subtracted and the rest is spread over the remaining links in proportion to their
-geometry volume). A link without any of these is reported and left alone.
+above are subtracted and the rest is spread over the remaining links with collision geometry, in
+proportion to its volume). A link with visual geometry only gets no share of ``--total-mass``: a
+visual-only link is a marker or decoration (an end-effector sphere, a sensor frustum), not a
+physical part, and its volume says nothing about the robot's mass (one such sphere took a third of
+a mobile base's mass). The output names the links that got a share and those left out, and why.
+A link without any mass source is reported and left alone.
 
 The centre of mass and tensor always come from the geometry (collision, else visual): the
 tensor is only right about the COM it was computed about. Frame links (no geometry, fixed
@@ -66,6 +70,8 @@ class _Target:
     geometry: inertia.GeometryMass | None = None
     mass: float | None = None
     mass_source: str = ""
+    no_mass: str = ""
+    """Why no mass source applies (shown instead of the generic "give --density ..." when set)."""
 
 
 def parse_masses(values: list[str] | None) -> dict[str, float]:
@@ -151,9 +157,9 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
     _assign_masses(model, targets, options, plan)
     for target in targets:
         if target.mass is None:
-            plan.skipped.append(Skipped(_element(target.link), target.link.line,
-                                        f"{target.reason}; no valid mass in the file: give --density, "
-                                        f"--mass {target.link.name}=KG or --total-mass"))
+            plan.skipped.append(Skipped(_element(target.link), target.link.line, f"{target.reason}; " + (
+                target.no_mass or f"no valid mass in the file: give --density, --mass {target.link.name}=KG "
+                                  "or --total-mass")))
             continue
         props = mp.scaled_to_mass(target.geometry.props, target.mass)
         geometry_source = f"{target.geometry.role}: " + "; ".join(target.geometry.sources)
@@ -183,24 +189,47 @@ def _assign_masses(model, targets: list[_Target], options: InertiaOptions, plan:
                                   f"{target.geometry.volume:.4g} m3")
         else:
             pending.append(target)
-    if options.total_mass is None or not pending:
+    if options.total_mass is not None and pending:
+        _spread_total_mass(model, targets, pending, options.total_mass, plan)
+
+
+def _spread_total_mass(model, targets: list[_Target], pending: list[_Target], total: float, plan: FixPlan) -> None:
+    """Give the ``pending`` links with collision geometry what ``total`` leaves after the known
+    masses, by volume; the visual-only ones get nothing and are named, with why."""
+    physical = [t for t in pending if t.geometry.role == "collision"]
+    markers = [t for t in pending if t.geometry.role != "collision"]
+    for target in markers:
+        target.no_mass = (f"visual geometry only (no <collision>): a marker or decoration, not a physical part, so "
+                          f"it gets no share of --total-mass; give --mass {target.link.name}=KG (or --density) if "
+                          "it weighs something")
+    left_out = (f"; left out (visual geometry only, no <collision>): {', '.join(t.link.name for t in markers)}"
+                if markers else "")
+    if not physical:
+        plan.notes.append(f"--total-mass: no link without a mass has collision geometry, nothing to spread "
+                          f"{number(total)} kg onto{left_out}")
         return
-    pending_names = {t.link.name for t in pending}
+    target_names = {t.link.name for t in targets}
     known = sum(t.mass for t in targets if t.mass is not None)
-    known += sum(_valid_file_mass(link) or 0.0 for link in model.links
-                 if link.name not in pending_names and link.name not in {t.link.name for t in targets})
-    remainder = options.total_mass - known
-    volume = sum(t.geometry.volume for t in pending)
+    known += sum(_valid_file_mass(link) or 0.0 for link in model.links if link.name not in target_names)
+    remainder = total - known
     if not remainder > 0:
-        raise UserError(f"--total-mass {number(options.total_mass)} kg: the other links already weigh "
-                        f"{known:.4g} kg, nothing is left for {', '.join(sorted(pending_names))}")
-    for target in pending:
+        raise UserError(f"--total-mass {number(total)} kg: the other links already weigh {known:.4g} kg, nothing "
+                        f"is left for {', '.join(sorted(t.link.name for t in physical))}")
+    volume = sum(t.geometry.volume for t in physical)
+    shares = []
+    for target in physical:
         share = target.geometry.volume / volume
         target.mass = remainder * share
-        target.mass_source = (f"--total-mass {number(options.total_mass)} kg: {remainder:.4g} kg left after the "
-                              f"known masses, spread by volume ({share:.1%})")
-    plan.notes.append(f"--total-mass: {known:.4g} kg in links with known masses, {remainder:.4g} kg spread over "
-                      f"{len(pending)} link(s) by volume")
+        target.mass_source = (f"--total-mass {number(total)} kg: {remainder:.4g} kg left after the "
+                              f"known masses, spread by collision volume ({share:.1%})")
+        shares.append(f"{target.link.name} {share:.1%}")
+    unselected = [link.name for link in model.links
+                  if link.collisions and link.name not in target_names and _valid_file_mass(link) is None]
+    if unselected:
+        left_out += (f"; not selected, and weighing nothing in the file: {', '.join(unselected)} (name them with "
+                     "--links, or use --all, to give them a share)")
+    plan.notes.append(f"--total-mass: {known:.4g} kg in links with known masses, {remainder:.4g} kg spread by "
+                      f"collision volume over {len(physical)} link(s): {', '.join(shares)}{left_out}")
 
 
 def _element(link) -> str:

@@ -4,9 +4,13 @@ What it fixes is decided by the lint rules themselves, run on the model at call 
 to a rule's heuristic changes the fixer with it):
 
 * J003 (lower > upper on a revolute or prismatic joint): ``lower`` and ``upper`` swapped, each
-  keeping the other's text byte for byte;
+  keeping the other's text byte for byte. PyBullet's deliberate "no limit" idiom (lower="1"
+  upper="-1", J014) is not J003's: it is left alone and named in a note (a swap would limit a
+  joint PyBullet users rely on being free);
 * J005 (revolute limits that look like degrees): ``lower`` and ``upper`` converted to radians,
-  both of them, as the rule's hint does (a person who typed one limit in degrees typed both);
+  both of them, as the rule's hint does (a person who typed one limit in degrees typed both). The
+  virtual joints of a floating base (a range such as ±20 shared with prismatic siblings, or a
+  chain of massless dummy links from the root) are not J005's, so they are never converted;
 * J009 (zero axis): not fixable, there is no direction to recover: reported as not fixed;
 * J010 (axis not a unit vector): normalised, written with :func:`~ar3cli.fix.driver.number`;
 * J007 (``<limit>`` without effort or velocity): filled from MoveIt's ``joint_limits.yaml``
@@ -29,6 +33,8 @@ from ar3cli.fix.edits import Document
 
 INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
 """The lint rules whose findings fix-joints acts on."""
+UNLIMITED_IDIOM = "J014"
+"""PyBullet's lower > upper "no limit" idiom: reported in a note, never changed."""
 SAME_NUMBER = 1e-12
 """Relative tolerance under which a computed value is the file's (and nothing is rewritten)."""
 
@@ -99,9 +105,15 @@ def plan_joints(model, document: Document, options: JointsOptions) -> FixPlan:
             _fill_effort_velocity(document, plan, joint, options)
     if swapped:
         plan.notes.append(f"note: {model.path}: PyBullet reads lower > upper as 'no limit'; the swapped joint(s) "
-                          f"{', '.join(swapped)} are limited to [lower, upper] there now. If the file meant unlimited "
-                          "(pybullet_data's lower=\"1\" upper=\"-1\" idiom), give the real travel instead, or make "
-                          "a revolute joint continuous")
+                          f"{', '.join(swapped)} are limited to [lower, upper] there now. If the file meant unlimited, "
+                          "give the real travel instead, or make a revolute joint continuous")
+    idiom_paths = flagged_joints(model, UNLIMITED_IDIOM)
+    idioms = [joint.name for joint in model.joints if _path(joint.element) in idiom_paths]
+    if idioms:
+        plan.notes.append(f"note: {model.path}: left {', '.join(idioms)} alone: lower > upper written as PyBullet's "
+                          "'no limit' idiom (lower=\"1\" upper=\"-1\", J014), unlimited in PyBullet; swapping it "
+                          "would limit the joint. For a portable file give the real travel, or make a revolute "
+                          "joint continuous")
     return plan
 
 

@@ -2,8 +2,8 @@
 
 Each rule names its fixer in ``fixed_by`` (``docs/rules.md``); this module turns a file's findings
 into one command per fixer, with the options that fixer needs for them (fix-inertia needs a mass
-source for links that have none; ``NAME=DIR`` and ``joint_limits.yaml`` are placeholders the user
-fills in).
+source for links that have none, but not for frame links, which get a tiny inertial; ``NAME=DIR``
+and ``joint_limits.yaml`` are placeholders the user fills in).
 """
 
 from __future__ import annotations
@@ -13,9 +13,18 @@ from collections.abc import Iterable
 
 from ar3cli.findings import Finding
 from ar3cli.lint.rules import REGISTRY
+from ar3cli.lint.rules.inertia import FRAME_LINK_PHRASE, fixed_link_inertial_missing
 
 NEEDS_MASS = frozenset({"I001", "I002", "I003"})
-"""Findings on links without a valid mass: fix-inertia needs --density (or --mass, --total-mass)."""
+"""Findings on links without a valid mass: fix-inertia needs --density (or --mass, --total-mass), except
+for frame links (I002 on a link without geometry: fix-inertia writes a tiny inertial, no mass needed)."""
+
+
+def needs_mass(finding: Finding) -> bool:
+    """True when fix-inertia needs a mass source (``--density``) to fix ``finding``."""
+    if finding.rule not in NEEDS_MASS:
+        return False
+    return not (finding.rule == fixed_link_inertial_missing.code and FRAME_LINK_PHRASE in finding.message)
 
 
 def fixed_by(code: str) -> str | None:
@@ -34,7 +43,7 @@ def fix_commands(path: str, findings: Iterable[Finding]) -> list[str]:
             continue
         command, *options = spec.split()
         known, codes = by_command.setdefault(command, ([], set()))
-        if finding.rule in NEEDS_MASS:
+        if needs_mass(finding):
             options = [*options, "--density", "KG_PER_M3"]
         for index in range(0, len(options)):
             option = options[index]

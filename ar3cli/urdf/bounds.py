@@ -1,5 +1,7 @@
-"""Axis-aligned boxes around a link's shapes, in the link frame: primitives exactly, meshes from
-their file bounds (:mod:`ar3cli.urdf.meshinfo`, cached) times their scale.
+"""Axis-aligned boxes around a link's shapes, in the link frame, in metres: primitives exactly,
+meshes from their file bounds (:mod:`ar3cli.urdf.meshinfo`, cached) times their scale and, for
+COLLADA, the file's ``<unit meter>`` (PyBullet and assimp apply it: a 6-unit cube in inches is
+15 cm to them, and to every rule that judges sizes from these boxes).
 
 Used by the lint rules (plausible sizes, inertia against geometry) and by ``render`` (framing the
 camera on what is drawn).
@@ -35,7 +37,7 @@ def shape_bounds(shape) -> Box | None:
     elif geometry.kind == "sphere" and params.get("radius") is not None:
         half = (abs(params["radius"]),) * 3
     elif geometry.kind == "mesh":
-        scaled = scaled_mesh_bounds(geometry)
+        scaled = metric_mesh_bounds(geometry)
         if scaled is None:
             return None
         low, high = scaled
@@ -50,8 +52,32 @@ def shape_bounds(shape) -> Box | None:
             tuple(c + h for c, h in zip(world_centre, world_half)))
 
 
+def mesh_unit(geometry) -> float | None:
+    """Metres per unit of the mesh file: a COLLADA file's ``<unit meter>`` (1.0 when it states none),
+    1.0 for the other formats (they carry no unit); None when a .dae states one that is not a
+    positive number (then its size in metres is unknown)."""
+    from ar3cli.urdf.meshinfo import collada_unit
+
+    resolution = geometry.resolution
+    if resolution is None or not resolution.found or resolution.path.suffix.lower() != ".dae":
+        return 1.0
+    return collada_unit(resolution.path)
+
+
+def metric_mesh_bounds(geometry) -> Box | None:
+    """The mesh's box in the shape frame in metres (file bounds times scale times the COLLADA unit),
+    or None when it cannot be read or its unit is unknown."""
+    scaled = scaled_mesh_bounds(geometry)
+    unit = mesh_unit(geometry) if scaled is not None else None
+    if scaled is None or unit is None:
+        return None
+    low, high = scaled
+    return tuple(v * unit for v in low), tuple(v * unit for v in high)  # type: ignore[return-value]
+
+
 def scaled_mesh_bounds(geometry) -> Box | None:
-    """The mesh's box in the shape frame (file bounds times scale), or None when it cannot be read."""
+    """The mesh's box in the shape frame in file units times scale (the COLLADA unit not applied:
+    :func:`metric_mesh_bounds` does), or None when it cannot be read."""
     from ar3cli.urdf.meshinfo import mesh_bounds
 
     resolution = geometry.resolution

@@ -23,6 +23,9 @@ with rounding noise (icub.urdf: (-1.355e-20, 0, 1.355e-20)). A 1 mg part 1 cm ac
 NEAR_SINGULAR_RATIO = 1e-9
 """Smallest / largest principal moment below which a tensor is near-singular. A real body cannot get
 there: a rod's ratio is 6 (r/L)², 1e-9 would be a 1 m rod 13 µm thick."""
+FRAME_LINK_PHRASE = "is a frame (no geometry)"
+"""I002's words for a link with neither geometry nor <inertial> on a fixed joint: fix-inertia gives such
+a frame a tiny inertial without any mass source, so ``lint-urdf --fix-hint`` asks for no --density."""
 DUMMY_ROOT_NAMES = frozenset({"world", "map", "odom", "base_footprint", "dummy", "root", "base_root"})
 """Root link names that are frames by convention (ROS REP 105 and KDL's "no inertia on the root")."""
 
@@ -101,7 +104,7 @@ def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
         link = ctx.model.link(joint.child) if joint.type == "fixed" and joint.child else None
         if link is None or link.inertial is not None or link.name == "world":
             continue
-        kind = "has geometry" if link.has_geometry else "is a frame (no geometry)"
+        kind = "has geometry" if link.has_geometry else FRAME_LINK_PHRASE
         yield Hit(f"link '{link.name}' {kind} on fixed joint '{joint.name}' without <inertial>: "
                   "PyBullet adds 1 kg and I = 1", link.element)
 

@@ -17,6 +17,13 @@ DEGREE_PLAUSIBLE = 720.0
 """A degree limit beyond two turns each way is not a typed angle (±1e16 is "unlimited")."""
 DEGREE_STEP = 5.0
 """Angles typed in degrees are round: 90, 135, 170, 180, 270, 360 are multiples of 5."""
+DUMMY_MASS = 1e-3
+"""kg: a link without geometry and at most this mass is a dummy of a virtual chain (massless frames
+written by fix-inertia weigh 1e-6 kg)."""
+PYBULLET_UNLIMITED = frozenset({(1.0, -1.0), (0.0, -1.0)})
+"""(lower, upper) pairs written on purpose to mean "no limit" in PyBullet: pybullet_data's
+lower="1" upper="-1" (cube_no_rotation.urdf, biped2d_pybullet.urdf) and (0, -1), what getJointInfo
+itself reports for an unlimited joint. PyBullet reads any lower > upper as unlimited."""
 WHEEL_LIKE = ("wheel", "caster", "castor", "roller", "rotor", "propeller", "prop_", "tire", "tyre", "track",
               "gear", "pulley", "spinner")
 """Name fragments of links that spin without stops by design (J011)."""
@@ -51,16 +58,30 @@ def limit_range_missing(ctx) -> Iterator[Hit]:
 
 @rule("J003", "limit-inverted", "error", "Joint lower limit greater than upper",
       why="""With lower > upper, PyBullet treats the joint as unlimited and MuJoCo disables the
-      limit; samplers drawing uniform(lower, upper) fail or sample nonsense.""",
+      limit; samplers drawing uniform(lower, upper) fail or sample nonsense. PyBullet's deliberate
+      "no limit" idiom (lower="1" upper="-1" as in pybullet_data, or lower="0" upper="-1") is not
+      reported here: J014 explains it instead, and fix-joints leaves it alone.""",
       fix="Swap lower and upper.",
-      bad=arm(joint_extra='<limit lower="1" upper="-1" effort="10" velocity="1"/>'), good=arm(),
+      bad=arm(joint_extra='<limit lower="1.5" upper="-1.5" effort="10" velocity="1"/>'), good=arm(),
+      thresholds="Not reported for the (lower, upper) pairs of PYBULLET_UNLIMITED: (1, -1) and (0, -1).",
       fixed_by="fix-joints")
 def limit_inverted(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         limit = joint.limit
-        if joint.type in LIMITED_TYPES and limit and limit.lower is not None and limit.upper is not None \
-                and limit.lower > limit.upper:
+        if _inverted(joint) and not _pybullet_unlimited_idiom(joint):
             yield Hit(f"joint '{joint.name}' lower {limit.lower:g} > upper {limit.upper:g}", limit.element)
+
+
+def _inverted(joint) -> bool:
+    """A revolute or prismatic joint whose lower limit is above its upper one."""
+    limit = joint.limit
+    return joint.type in LIMITED_TYPES and limit is not None and limit.lower is not None \
+        and limit.upper is not None and limit.lower > limit.upper
+
+
+def _pybullet_unlimited_idiom(joint) -> bool:
+    """lower > upper with exactly one of the PYBULLET_UNLIMITED pairs: "no limit" written on purpose."""
+    return _inverted(joint) and (joint.limit.lower, joint.limit.upper) in PYBULLET_UNLIMITED
 
 
 @rule("J004", "limit-empty", "warning", "Moving joint with lower == upper",
@@ -88,12 +109,18 @@ def _looks_like_degrees(value: float) -> bool:
       why="""URDF angles are radians. A revolute limit of 90 or 180 is almost always a value typed in
       degrees: 90 rad is 14 turns. Multi-turn joints legitimately go beyond ±2π (±3π, ±10, -3.05 to
       6.81 are real radian limits), so only values that cannot be radians for a robot joint
-      (beyond ±4π) and look like typed degrees (a round number up to 720) are reported.""",
+      (beyond ±4π) and look like typed degrees (a round number up to 720) are reported.
+      The virtual joints of a floating base (a hand or gripper moved by 3 prismatic + 3 revolute
+      joints through dummy links) are not: they often share one "large enough" range such as ±20
+      between the prismatic joints (metres) and the revolute ones, which is no typed angle. A
+      revolute joint is taken as virtual when a prismatic joint of the same chain of geometry-less
+      links has the very same lower/upper, or when every link from the root down to its parent is
+      a massless dummy (no geometry, mass at most DUMMY_MASS) with a moving joint among them.""",
       fix="Convert to radians (degrees × π/180).",
       bad=arm(joint_extra='<limit lower="-90" upper="90" effort="10" velocity="1"/>'),
       good=arm(joint_extra='<limit lower="-9.42478" upper="9.42478" effort="10" velocity="1"/>'),
       thresholds="A value v is reported when RADIAN_PLAUSIBLE = 4π < |v| <= DEGREE_PLAUSIBLE = 720 and v is a "
-                 "multiple of DEGREE_STEP = 5.",
+                 "multiple of DEGREE_STEP = 5; dummy links weigh at most DUMMY_MASS = 1e-3 kg.",
       fixed_by="fix-joints")
 def limit_degrees(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
@@ -101,11 +128,64 @@ def limit_degrees(ctx) -> Iterator[Hit]:
         if joint.type != "revolute" or limit is None:
             continue
         values = [v for v in (limit.lower, limit.upper) if v is not None and math.isfinite(v)]
-        if any(map(_looks_like_degrees, values)):
+        if any(map(_looks_like_degrees, values)) and virtual_base_evidence(ctx.model, joint) is None:
             shown = ", ".join(f"{v:g}" for v in values)
             yield Hit(f"revolute joint '{joint.name}' limits ({shown}) look like degrees: {max(map(abs, values)):g} rad "
                       f"is {max(map(abs, values)) / (2 * math.pi):.0f} turns", limit.element,
                       hint=f"In radians: {', '.join(f'{math.radians(v):.4f}' for v in values)}.")
+
+
+def _dummy(link, massless: bool) -> bool:
+    """A link with no geometry (and, when ``massless``, no mass above DUMMY_MASS): a frame of a virtual chain."""
+    if link is None or link.has_geometry:
+        return False
+    mass = link.inertial.mass if link.inertial is not None else None
+    return not massless or mass is None or not mass > DUMMY_MASS
+
+
+def _virtual_chain(model, joint) -> list:
+    """The joints linked to ``joint`` through links without geometry, up and down (``joint`` included)."""
+    chain, seen, stack = [], {joint.name}, [joint]
+    while stack:
+        current = stack.pop()
+        chain.append(current)
+        neighbours = []
+        if current.parent and _dummy(model.link(current.parent), massless=False):
+            neighbours.append(model.parent_joint(current.parent))
+            neighbours.extend(model.child_joints(current.parent))
+        if current.child and _dummy(model.link(current.child), massless=False):
+            neighbours.extend(model.child_joints(current.child))
+        for other in neighbours:
+            if other is not None and other.name not in seen:
+                seen.add(other.name)
+                stack.append(other)
+    return chain
+
+
+def virtual_base_evidence(model, joint) -> str | None:
+    """Why ``joint`` is a virtual joint of a floating base (see J005), or None when nothing says so.
+
+    Evidence: a prismatic joint of the same geometry-less chain with the very same lower/upper (a
+    range shared with joints in metres is no angle), or a floating chain: every link from the root
+    down to the joint's parent is a massless dummy, and a moving joint lies among them.
+    """
+    limit = joint.limit
+    if limit is not None and limit.lower is not None and limit.upper is not None:
+        for other in _virtual_chain(model, joint):
+            if other.type == "prismatic" and other.limit is not None \
+                    and (other.limit.lower, other.limit.upper) == (limit.lower, limit.upper):
+                return f"same limits as prismatic joint '{other.name}' of its virtual chain"
+    moving, name, seen = 0, joint.parent, set()
+    while name is not None and name not in seen:
+        seen.add(name)
+        if not _dummy(model.link(name), massless=True):
+            return None
+        above = model.parent_joint(name)
+        if above is None:
+            return "floating chain of massless dummy links from the root" if moving else None
+        moving += above.moves
+        name = above.parent
+    return None
 
 
 @rule("J006", "continuous-with-range", "warning", "Continuous joint with lower/upper",
@@ -332,6 +412,26 @@ def joint_type_portability(ctx) -> Iterator[Hit]:
             yield Hit(f"{joint.type} joint '{joint.name}': {PORTABILITY[joint.type]}", joint.element)
 
 
+@rule("J014", "pybullet-unlimited-idiom", "info", "lower > upper written as PyBullet's \"no limit\"",
+      why="""pybullet_data writes lower="1" upper="-1" on purpose (cube_no_rotation.urdf,
+      biped2d_pybullet.urdf): PyBullet reads any lower > upper as unlimited, and (0, -1) is what
+      getJointInfo reports for an unlimited joint. It is not an inverted range to swap (J003): a
+      swap would limit a free joint in PyBullet. Other tools do not share the idiom: urdfdom and
+      MoveIt read an empty, inverted range, and samplers drawing uniform(lower, upper) fail.""",
+      fix="Keep it for PyBullet only; for a portable file make a revolute joint continuous, or give a prismatic "
+          "joint its real travel.",
+      bad=arm(joint_type="prismatic", joint_extra='<limit lower="1" upper="-1" effort="0" velocity="1000"/>'),
+      good=arm(joint_type="prismatic"),
+      thresholds="The (lower, upper) pairs of PYBULLET_UNLIMITED: (1, -1) and (0, -1).")
+def pybullet_unlimited_idiom(ctx) -> Iterator[Hit]:
+    for joint in ctx.model.joints:
+        if _pybullet_unlimited_idiom(joint):
+            limit = joint.limit
+            yield Hit(f"{joint.type} joint '{joint.name}' lower {limit.lower:g} > upper {limit.upper:g}: PyBullet's "
+                      "\"no limit\" idiom (unlimited in PyBullet; urdfdom and MoveIt read an inverted range)",
+                      limit.element)
+
+
 RULES = (limit_missing, limit_range_missing, limit_inverted, limit_empty, limit_degrees, continuous_with_range,
          effort_velocity_missing, effort_velocity_zero, axis_zero, axis_not_unit, continuous_arm_joint,
-         mimic_not_single_dof, joint_type_portability)
+         mimic_not_single_dof, joint_type_portability, pybullet_unlimited_idiom)
