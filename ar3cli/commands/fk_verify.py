@@ -11,6 +11,7 @@ from ar3cli.commands.options import (
     RobotPathArgument,
     SeedOption,
     XacroArgOption,
+    finite_float,
     samples_option,
 )
 from ar3cli.errors import UserError
@@ -20,8 +21,9 @@ from ar3cli.urdf.loading import load_with_specs
 SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
                                                   help="A DH table to check against the URDF (see docs).")]
-ToleranceMOption = Annotated[float, typer.Option("--tolerance-m", help="Largest position error that passes (m).")]
-ToleranceRadOption = Annotated[float, typer.Option("--tolerance-rad",
+ToleranceMOption = Annotated[float, typer.Option("--tolerance-m", click_type=finite_float(),
+                                                 help="Largest position error that passes (m).")]
+ToleranceRadOption = Annotated[float, typer.Option("--tolerance-rad", click_type=finite_float(),
                                                    help="Largest orientation error that passes (rad, geodesic).")]
 
 
