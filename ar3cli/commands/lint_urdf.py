@@ -68,6 +68,10 @@ def lint_urdf(
                                                        "one file as one row (count, first locations, message); on "
                                                        "by default. JSON, SARIF, github and markdown keep every "
                                                        "finding.", show_default=False)] = None,
+    wide: Annotated[bool, typer.Option("--wide", help="Text format: one line per finding, however wide (for grep "
+                                                      "and wide log viewers). By default tables fit the terminal "
+                                                      "(or COLUMNS) and wrap messages; piped without COLUMNS, they "
+                                                      "are one line per row anyway.")] = False,
     baseline: Annotated[Optional[Path], typer.Option("--baseline", metavar="FILE",
                                                      help="Do not report (or fail on) the findings this baseline "
                                                           "file holds; only new ones count.", show_default=False)]
@@ -172,6 +176,7 @@ def lint_urdf(
         report.data["fix_commands"] = commands
         report.lines += [f"to fix: {line}" for line in commands] or ["to fix: no finding has an ar3cli fixer"]
     report.ok = report.ok or exit_zero
+    report.wide = wide
     report.errors = [*report.errors, *(result.error for result in results if result.error)]
     finish(report, "json" if fmt in (LintFormat.json, LintFormat.sarif) else "text")
 
