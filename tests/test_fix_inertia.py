@@ -282,9 +282,9 @@ def test_options_and_io_errors(cli, tmp_path, write_urdf):
         (["-o", str(out), str(other)], "exactly one input"),
         (["--mass", "box"], "expected LINK=KG"),
         (["--links", "nope"], "no link named 'nope'"),
-        (["--density", "-3"], "must be a positive number"),
-        (["--density", "inf"], "must be a positive number"),
-        (["--total-mass", "inf"], "must be a positive number"),
+        (["--density", "-3"], "must be a density between"),
+        (["--density", "inf"], "must be a finite number"),
+        (["--total-mass", "inf"], "must be a finite number"),
     ]:
         result = cli("fix-inertia", str(path), *args)
         assert result.code == 2 and message in result.stderr and "Traceback" not in result.stderr

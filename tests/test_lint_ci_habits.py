@@ -89,18 +89,20 @@ def test_junit_report(cli, tmp_path):
     result = cli("lint-urdf", ".", "--format", "junit", cwd=tmp_path)
     assert result.code == 1 and "FAILED: 3 files checked" in result.stderr  # the summary stays off stdout
     root = ET.fromstring(result.stdout)
-    assert root.tag == "testsuites" and [child.tag for child in root] == ["testsuite"]
-    suite = root[0]
-    cases = {case.get("name"): case for case in suite.findall("testcase")}
-    assert list(cases) == ["bad.urdf", "warn.urdf", "zgood.urdf"]
-    assert (suite.get("tests"), suite.get("failures"), suite.get("errors")) == ("3", "1", "0")
-    (failure,) = cases["bad.urdf"].findall("failure")
+    assert root.tag == "testsuites" and [child.tag for child in root] == ["testsuite"] * 3  # one per file
+    suites = {suite.get("name"): suite for suite in root}
+    assert list(suites) == ["bad.urdf", "warn.urdf", "zgood.urdf"]
+    assert (root.get("tests"), root.get("failures"), root.get("errors")) == ("3", "1", "0")
+    (case,) = suites["bad.urdf"].findall("testcase")  # one testcase per failing finding
+    (failure,) = case.findall("failure")
+    assert case.get("name") == "J001 bad.urdf:5:3" and case.get("classname") == "bad.urdf"
     assert failure.get("type") == "J001" and failure.get("message").startswith("bad.urdf:5:3: J001 ")
     assert "fix: Add <limit" in failure.text
-    assert cases["warn.urdf"].find("failure") is None and "J008" in cases["warn.urdf"].find("system-out").text
-    assert len(cases["zgood.urdf"]) == 0
+    (passing,) = suites["warn.urdf"].findall("testcase")
+    assert passing.find("failure") is None and "J008" in passing.find("system-out").text
+    assert [len(case) for case in suites["zgood.urdf"]] == [0]  # a clean file is one passing testcase
     strict = ET.fromstring(cli("lint-urdf", ".", "-f", "junit", "--fail-on", "warning", cwd=tmp_path).stdout)
-    assert strict[0].get("failures") == "2" and strict.find(".//testcase[@name='warn.urdf']/failure") is not None
+    assert strict.get("failures") == "2" and strict.find(".//testsuite[@name='warn.urdf']/testcase/failure") is not None
 
 
 def test_junit_escapes_markup_and_forbidden_characters(cli, tmp_path):
@@ -113,7 +115,7 @@ def test_junit_escapes_markup_and_forbidden_characters(cli, tmp_path):
     root = ET.fromstring(result.stdout)  # well-formed
     messages = [failure.get("message") for failure in root.iter("failure")]
     assert any("joint 'j&1 <x> \"q\"' has no <limit>" in message for message in messages)
-    assert root.find(".//testcase[@name='odd & <name>.urdf']") is not None
+    assert root.find(".//testsuite[@name='odd & <name>.urdf']") is not None
     assert xml_text("a\x00b\x1bc\td") == "a\\x00b\\x1bc\td"
 
 

@@ -4,14 +4,23 @@ from typing import Annotated
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    finite_float,
+)
 from ar3cli.output.report import OutputFormat
 
 
 def fix_collision(
     paths: FixPathsArgument,
     max_hull_ratio: Annotated[float, typer.Option(
-        "--max-hull-ratio", help="Decompose a collision mesh whose convex hull has more than this many times "
+        "--max-hull-ratio", click_type=finite_float(),
+        help="Decompose a collision mesh whose convex hull has more than this many times "
                                  "its volume (the mesh must be closed).")] = 2.0,
     method: Annotated[str, typer.Option(
         "--method", help="coacd, vhacd (pybullet's), or auto: coacd when installed (pip install "

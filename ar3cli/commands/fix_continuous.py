@@ -5,7 +5,15 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    finite_float,
+)
 from ar3cli.output.report import OutputFormat
 
 
@@ -17,9 +25,11 @@ def fix_continuous(
     to_continuous: Annotated[bool, typer.Option(
         "--to-continuous", help="Revolute joints whose range covers a full turn (>= 2 pi) become continuous.")] = False,
     effort: Annotated[Optional[float], typer.Option(
-        "--effort", help="Effort (N*m or N) to add where a fixed joint's `<limit>` has none.")] = None,
+        "--effort", click_type=finite_float(),
+        help="Effort (N*m or N) to add where a fixed joint's `<limit>` has none.")] = None,
     velocity: Annotated[Optional[float], typer.Option(
-        "--velocity", help="Velocity (rad/s or m/s) to add where a fixed joint's `<limit>` has none.")] = None,
+        "--velocity", click_type=finite_float(),
+        help="Velocity (rad/s or m/s) to add where a fixed joint's `<limit>` has none.")] = None,
     verify: Annotated[bool, typer.Option(
         "--verify/--no-verify", help="After writing, load the result in PyBullet and check the joints.")] = True,
     diff: DiffOption = False,

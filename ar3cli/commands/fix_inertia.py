@@ -5,8 +5,23 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    finite_float,
+)
 from ar3cli.output.report import OutputFormat
+
+DENSITY_RANGE = (0.01, 1e6)
+"""Densities that are a material, in kg/m^3: expanded foams and aerogels start near 1, osmium is
+22,590; the margins take units slips the user meant. Outside it the inertia written is no
+physics (``--density 1e-320`` gave masses of 1e-323 kg, subnormal numbers that underflow to 0)."""
+SMALLEST_MASS = 1e-9
+"""A microgram: below it, masses and inertias are round-off, not a robot."""
 
 
 def fix_inertia(
@@ -19,11 +34,11 @@ def fix_inertia(
         help="Also recompute links whose inertia is valid but implausible for their geometry (I007: "
              "often a hand-tuned value or a deliberate placeholder). By default they are left alone "
              "and listed.")] = False,
-    density: Annotated[Optional[float], typer.Option("--density", metavar="KG_PER_M3",
+    density: Annotated[Optional[float], typer.Option("--density", metavar="KG_PER_M3", click_type=finite_float(),
                                                      help="Density for links without a valid mass.")] = None,
     mass: Annotated[Optional[list[str]], typer.Option("--mass", metavar="LINK=KG",
                                                       help="Mass of one link (repeatable); overrides the file.")] = None,
-    total_mass: Annotated[Optional[float], typer.Option("--total-mass", metavar="KG",
+    total_mass: Annotated[Optional[float], typer.Option("--total-mass", metavar="KG", click_type=finite_float(),
                                                         help="The robot's total mass: what the known masses leave "
                                                              "is spread over links without one, by volume.")] = None,
     diff: DiffOption = False,
@@ -44,10 +59,11 @@ def fix_inertia(
     from ar3cli.fix.driver import run_fixer
     from ar3cli.fix.inertia_plan import InertiaOptions, make_fixer, parse_masses
 
-    if density is not None and not 0 < density < math.inf:
-        raise UserError(f"--density {density}: must be a positive number (kg/m^3, e.g. 1200 for PLA)")
-    if total_mass is not None and not 0 < total_mass < math.inf:
-        raise UserError(f"--total-mass {total_mass}: must be a positive number (kg)")
+    if density is not None and not DENSITY_RANGE[0] <= density <= DENSITY_RANGE[1]:
+        raise UserError(f"--density {density}: must be a density between {DENSITY_RANGE[0]:g} and "
+                        f"{DENSITY_RANGE[1]:g} kg/m^3 (e.g. 1200 for PLA, 2700 for aluminium, 7850 for steel)")
+    if total_mass is not None and not SMALLEST_MASS <= total_mass < math.inf:
+        raise UserError(f"--total-mass {total_mass}: must be a mass of at least {SMALLEST_MASS:g} kg")
     if links is not None and all_links:
         raise UserError("--links and --all exclude each other")
     if include_implausible and (links is not None or all_links):

@@ -5,16 +5,25 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    finite_float,
+)
 from ar3cli.output.report import OutputFormat
 
 
 def fix_joints(
     paths: FixPathsArgument,
     effort: Annotated[Optional[float], typer.Option(
-        "--effort", help="Effort (N*m or N) to add where a `<limit>` has none (J007).")] = None,
+        "--effort", click_type=finite_float(), help="Effort (N*m or N) to add where a `<limit>` has none (J007).")] = None,
     velocity: Annotated[Optional[float], typer.Option(
-        "--velocity", help="Velocity (rad/s or m/s) to add where a `<limit>` has none (J007).")] = None,
+        "--velocity", click_type=finite_float(),
+        help="Velocity (rad/s or m/s) to add where a `<limit>` has none (J007).")] = None,
     limits_from: Annotated[Optional[Path], typer.Option(
         "--limits-from", metavar="JOINT_LIMITS_YAML",
         help="MoveIt joint_limits.yaml: its max_effort / max_velocity fill a `<limit>` without them "

@@ -11,6 +11,7 @@ from ar3cli.commands.options import (
     RobotPathArgument,
     SeedOption,
     XacroArgOption,
+    finite_float,
     samples_option,
 )
 from ar3cli.errors import UserError
@@ -22,11 +23,11 @@ DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
                                                   help="A DH table to check against the URDF (see docs).")]
 DEFAULT_TOLERANCE_M = 1e-6
 ToleranceMOption = Annotated[Optional[float], typer.Option(
-    "--tolerance-m", show_default=False,
+    "--tolerance-m", show_default=False, click_type=finite_float(),
     help="Largest position error that passes (m). Default: 1e-6 m, raised far from the origin to 4 float32 epsilons "
          "x the link's reach (pybullet's single precision; a mobile base 20 m out gets 9.5e-6 m). A value given "
          "here is used as is.")]
-ToleranceRadOption = Annotated[float, typer.Option("--tolerance-rad",
+ToleranceRadOption = Annotated[float, typer.Option("--tolerance-rad", click_type=finite_float(),
                                                    help="Largest orientation error that passes (rad, geodesic).")]
 
 

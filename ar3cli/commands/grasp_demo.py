@@ -7,7 +7,7 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from ar3cli.commands.options import FormatOption, SeedOption
+from ar3cli.commands.options import FormatOption, SeedOption, finite_float
 from ar3cli.errors import UserError
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 
@@ -25,7 +25,7 @@ def grasp_demo(
     record: Annotated[Optional[Path], typer.Option("--record", metavar="FILE.gif",
                                                    help="Write an animated GIF from a fixed camera "
                                                         "(TinyRenderer, 320x240, 15 fps of sim time).")] = None,
-    gripper_force: Annotated[float, typer.Option("--gripper-force", metavar="N",
+    gripper_force: Annotated[float, typer.Option("--gripper-force", metavar="N", click_type=finite_float(),
                                                  help="Squeeze force per finger in N (at most the model's "
                                                       "finger effort, 30 N). Low values make the "
                                                       "grasp slip.")] = 20.0,

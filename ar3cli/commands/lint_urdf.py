@@ -7,7 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.commands.options import PackagePathOption, XacroArgOption
-from ar3cli.errors import UserError
+from ar3cli.errors import EXIT_USAGE, UserError
 from ar3cli.output.report import Report, Table, finish
 
 
@@ -68,6 +68,10 @@ def lint_urdf(
                                                        "one file as one row (count, first locations, message); on "
                                                        "by default. JSON, SARIF, github and markdown keep every "
                                                        "finding.", show_default=False)] = None,
+    wide: Annotated[bool, typer.Option("--wide", help="Text format: one line per finding, however wide (for grep "
+                                                      "and wide log viewers). By default tables fit the terminal "
+                                                      "(or COLUMNS) and wrap messages; piped without COLUMNS, they "
+                                                      "are one line per row anyway.")] = False,
     baseline: Annotated[Optional[Path], typer.Option("--baseline", metavar="FILE",
                                                      help="Do not report (or fail on) the findings this baseline "
                                                           "file holds; only new ones count.", show_default=False)]
@@ -150,6 +154,8 @@ def lint_urdf(
         results, baselined, unused = apply_baseline(results, accepted)
         held = {"baselined": baselined, "baseline_unused": unused}
     summary = {**summarize(results, threshold), **(held or {})}
+    summary["exit_code"] = EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] and \
+        not exit_zero else 0
     grouped = True if group is None else group
     if selection is not None and not results and fmt is LintFormat.text:
         report = Report(data={}, lines=[changed_note(selection)])
@@ -170,6 +176,7 @@ def lint_urdf(
         report.data["fix_commands"] = commands
         report.lines += [f"to fix: {line}" for line in commands] or ["to fix: no finding has an ar3cli fixer"]
     report.ok = report.ok or exit_zero
+    report.wide = wide
     report.errors = [*report.errors, *(result.error for result in results if result.error)]
     finish(report, "json" if fmt in (LintFormat.json, LintFormat.sarif) else "text")
 
@@ -269,9 +276,9 @@ def _split(items: list[str] | None) -> list[str]:
 def summary_line(summary: dict, cached: int = 0) -> str:
     """The verdict line; ``cached`` files answered from the result cache are said when there are any."""
     files = summary["files"]
-    broken = summary["files_with_errors"]
+    broken = summary["files_not_checked"]
     clean = summary["files_clean"]
-    verdict = "FAILED" if summary["failed"] or broken else "passed"
+    verdict = "FAILED" if summary["failed"] else "passed"
     unchecked = f"; {broken} not fully checked (pybullet crashed)" if broken else ""
     remembered = f"; {cached} unchanged since an earlier run (from the cache)" if cached else ""
     held = ""
@@ -294,7 +301,7 @@ def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool 
     findings = [f for result in results for f in result.findings]
     data = {"files": [r.to_dict() for r in results],
             "findings": [{**f.to_dict(), "fixed_by": fixed_by(f.rule)} for f in findings], "summary": summary}
-    ok = not summary["failed"]
+    ok = not summary["findings_failing"]  # a file not checked is exit 2 (Report.errors), not 1
     if fmt is LintFormat.sarif:
         from ar3cli.output.sarif import sarif_document
 

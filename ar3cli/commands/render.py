@@ -5,7 +5,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
+from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, finite_float
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 from ar3cli.urdf.loading import load_with_specs
 
@@ -21,8 +21,9 @@ def render_command(
         "--collision", help="Draw the collision geometry (blue) instead of the visual geometry.")] = False,
     width: Annotated[int, typer.Option(help="Image width in pixels.")] = 800,
     height: Annotated[int, typer.Option(help="Image height in pixels.")] = 600,
-    yaw: Annotated[float, typer.Option(help="Camera yaw around the robot, degrees.")] = 45.0,
-    pitch: Annotated[float, typer.Option(help="Camera pitch, degrees (negative looks down).")] = -20.0,
+    yaw: Annotated[float, typer.Option(click_type=finite_float(), help="Camera yaw around the robot, degrees.")] = 45.0,
+    pitch: Annotated[float, typer.Option(click_type=finite_float(),
+                                         help="Camera pitch, degrees (negative looks down).")] = -20.0,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     format: FormatOption = OutputFormat.text,

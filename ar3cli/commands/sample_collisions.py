@@ -11,6 +11,7 @@ from ar3cli.commands.options import (
     RobotPathArgument,
     SeedOption,
     XacroArgOption,
+    finite_float,
     samples_option,
 )
 from ar3cli.errors import UserError
@@ -24,7 +25,7 @@ JobsOption = Annotated[Optional[int], typer.Option(
     help="Processes that share the samples, at most one per CPU (forked copies of the loaded model). Default "
          "on Linux: one per 2000 samples, at most one per CPU; elsewhere 1. The counts are exact and the same "
          "for any value.")]
-ThresholdOption = Annotated[float, typer.Option("--always-threshold", min=0.01, max=1.0,
+ThresholdOption = Annotated[float, typer.Option("--always-threshold", click_type=finite_float(0.01, 1.0),
                                                 help="A pair in contact in at least this fraction of samples "
                                                      "is 'always' colliding.")]
 SrdfOption = Annotated[Optional[Path], typer.Option("--srdf", metavar="OUT", dir_okay=False,

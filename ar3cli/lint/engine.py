@@ -450,14 +450,23 @@ def group_findings(findings: list[Finding], at_least: int = GROUP_AT) -> list[Fi
 
 
 def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
-    """Counts for the summary line and the JSON ``summary`` object."""
+    """Counts for the summary line and the JSON ``summary`` object (docs/commands/lint-urdf.md).
+
+    ``error``/``warning``/``info`` count findings; ``files_with_errors`` the files with at least one
+    error finding (so it is 0 exactly when ``error`` is); ``files_not_checked`` the files whose check
+    was cut short (pybullet crashed: exit 2). ``failed`` is the verdict of the summary line: a
+    finding at or above ``fail_on`` (``findings_failing``), or a file not checked.
+    """
     findings = [f for r in results for f in r.findings]
     counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}
+    failing = sum(f.severity >= fail_on for f in findings)
+    not_checked = sum(r.error is not None for r in results)
     return {"files": len(results), "files_with_findings": sum(bool(r.findings) for r in results),
-            "files_with_errors": sum(r.error is not None for r in results),
+            "files_with_errors": sum(any(f.severity is Severity.ERROR for f in r.findings) for r in results),
+            "files_not_checked": not_checked,
             "files_clean": sum(not r.findings and r.error is None for r in results),
-            "findings": len(findings), **counts, "fail_on": fail_on.value,
-            "failed": any(f.severity >= fail_on for f in findings)}
+            "findings": len(findings), **counts, "fail_on": fail_on.value, "findings_failing": failing,
+            "failed": bool(failing or not_checked)}
 
 
 def find_rule(code: str) -> Rule:

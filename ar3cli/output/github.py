@@ -1,10 +1,16 @@
-"""GitHub Actions workflow-command annotations and a Markdown table for ``$GITHUB_STEP_SUMMARY``."""
+"""GitHub Actions workflow-command annotations and a Markdown table for ``$GITHUB_STEP_SUMMARY``.
+
+Paths, messages and hints go through :func:`~ar3cli.output.report.printable` first: a link named
+with an escape sequence must not repaint the CI log, and a bidi override must not reorder a
+reviewer's summary page.
+"""
 
 from __future__ import annotations
 
 import os
 
 from ar3cli.findings import Finding, Severity
+from ar3cli.output.report import printable
 
 COMMANDS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "notice"}
 
@@ -21,17 +27,17 @@ def escape_property(text: str) -> str:
 
 def annotation(finding: Finding) -> str:
     """``::error file=PATH,line=L,col=C,title=CODE::message (fix: hint)``."""
-    properties = [f"file={escape_property(finding.path)}"]
+    properties = [f"file={escape_property(printable(finding.path))}"]
     if finding.line:
         properties += [f"line={finding.line}", f"col={max(finding.column, 1)}"]
-    properties.append(f"title={escape_property(finding.rule)}")
+    properties.append(f"title={escape_property(printable(finding.rule))}")
     message = finding.message + (f" (fix: {finding.hint})" if finding.hint else "")
-    return f"::{COMMANDS[finding.severity]} {','.join(properties)}::{escape_data(message)}"
+    return f"::{COMMANDS[finding.severity]} {','.join(properties)}::{escape_data(printable(message))}"
 
 
 def markdown_cell(text: str) -> str:
     """Text safe inside a table cell: pipes escaped, and ``<inertial>`` shown, not eaten as an HTML tag."""
-    text = text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
+    text = printable(text).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
     return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
 
 
@@ -43,7 +49,7 @@ def markdown_table(findings: list[Finding], summary_line: str) -> str:
         lines += [f"| `{markdown_cell(f.location)}` | {f.rule} | {f.severity.value} | {markdown_cell(f.message)} | "
                   f"{markdown_cell(f.hint)} |" for f in findings]
         lines.append("")
-    lines.append(summary_line)
+    lines.append(printable(summary_line))
     return "\n".join(lines) + "\n"
 
 

@@ -1,8 +1,13 @@
 """The one output layer: every command hands it a :class:`Report` and a format.
 
 Text goes to a rich console on a terminal (tables with colour, without it when ``NO_COLOR`` is
-set). Off a terminal (pipes, CI logs, pre-commit) tables are plain ASCII, one line per row, and
-rich is not even imported unless the report holds rich renderables. JSON goes to stdout alone, so
+set), fitted to its width (``COLUMNS`` wins): long cells wrap inside their column. Off a terminal
+(pipes, CI logs, pre-commit) tables are plain ASCII, one line per row (what grep and log viewers
+want), unless ``COLUMNS`` is set: then they fit that width the same way; rich is not even imported
+unless the report holds rich renderables. ``Report.wide`` (lint-urdf's ``--wide``) asks for one
+line per row everywhere. Names from robot files (paths, links, joints) reach text output through
+:func:`printable`, so a control character in them (a terminal escape sequence, ``\\r``, a bidi
+override) is shown as ``\\x1b``, never obeyed by the terminal; JSON keeps the exact strings. JSON goes to stdout alone, so
 ``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing to write
 the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
 Lint's extra formats (sarif, github, markdown) live in their own modules and use the same Report.
@@ -14,6 +19,7 @@ import enum
 import json
 import math
 import os
+import re
 import sys
 from dataclasses import dataclass, field
 from typing import Any, NoReturn, TextIO
@@ -65,6 +71,8 @@ class Report:
     errors: list[str] = field(default_factory=list)
     """One-line errors about part of the work (a file whose pybullet run crashed) while the rest was
     reported: written to stderr as ``ar3cli: error: ...`` in every format, and the exit code is 2."""
+    wide: bool = False
+    """Text tables one line per row whatever the width (``--wide``): for grep and wide log viewers."""
 
 
 def console(stderr: bool = False):
@@ -78,8 +86,24 @@ def console(stderr: bool = False):
                    force_terminal=False if plain else None)
 
 
+_CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069]")
+"""Characters a terminal or a log viewer obeys instead of showing: C0 controls but tab and
+newline (ESC starts escape sequences, CR rewrites the line, BS erases), DEL, C1 controls (CSI
+0x9b), and the bidirectional marks, embeddings, overrides and isolates (the "Trojan Source" ones)."""
+
+
+def printable(text: str) -> str:
+    """``text`` with every :data:`_CONTROL` character written as ``\\xNN`` (``\\uNNNN`` above
+    0xff): what every text, github and markdown output does with names that come from robot files."""
+    if text.isprintable():  # the usual case, one C-level scan
+        return text
+    return _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}" if ord(match.group()) < 0x100
+                        else f"\\u{ord(match.group()):04x}", text)
+
+
 def format_cell(value: Any) -> str:
-    """Numbers compactly (4 significant digits, scientific when tiny/huge); None as a dash."""
+    """Numbers compactly (4 significant digits, scientific when tiny/huge); None as a dash; text
+    through :func:`printable`."""
     if value is None:
         return "-"
     if isinstance(value, bool):
@@ -89,29 +113,113 @@ def format_cell(value: Any) -> str:
             return str(value)
         magnitude = abs(value)
         return f"{value:.4g}" if 1e-3 <= magnitude < 1e5 else f"{value:.3e}"
-    return str(value)
+    return printable(str(value))
 
 
-def plain_table(table: Table) -> str:
-    """An ASCII table, one line per row and no wrapping: what pipes, CI logs and grep want.
+def table_width(stream: TextIO, wide: bool = False) -> int | None:
+    """How many columns a text table on ``stream`` may take; None for no limit (one line per row).
 
-    Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's 659 lint findings);
-    off a terminal nobody sees its wrapping, so this is a plain, fast formatter.
+    ``wide`` (``--wide``): no limit. Else ``COLUMNS`` when set (at least 20, so a stray tiny value
+    cannot fold every word), else the terminal's width, else (a pipe, a file, a CI log) no limit.
+    """
+    if wide:
+        return None
+    columns = os.environ.get("COLUMNS", "").strip()
+    if columns.isdigit() and int(columns) >= 20:
+        return int(columns)
+    if stream.isatty():
+        import shutil
+
+        return shutil.get_terminal_size().columns
+    return None
+
+
+MIN_WRAPPED_WIDTH = 12
+"""A wrapped column narrower than this reads as a word list: the table is printed as blocks."""
+
+
+def plain_table(table: Table, width: int | None = None) -> str:
+    """An ASCII table: one line per row when ``width`` is None, else fitted into ``width`` columns.
+
+    Fitting keeps the short columns whole (location, code, severity, numbers: what grep looks for,
+    on each row's first line) and wraps the long ones (message, hint) inside their cells; when the
+    long ones would get fewer than :data:`MIN_WRAPPED_WIDTH` columns, each row is a block instead
+    (:func:`plain_blocks`). Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's
+    659 lint findings); this plain formatter is what pipes, CI logs and ``--wide`` get.
     """
     rows = [[format_cell(value).replace("\n", " ") for value in row] for row in table.rows]
-    widths = [max([len(column), *(len(row[index]) for row in rows)]) for index, column in enumerate(table.columns)]
+    natural = [max([len(column), *(len(row[index]) for row in rows)]) for index, column in enumerate(table.columns)]
+    widths = natural if width is None else _fitted_widths(table, natural, rows, width - 3 * len(natural) - 1)
+    if widths is None:
+        return plain_blocks(table, rows, width or 80)
     numeric = [column in table.numeric_columns for column in table.columns]
 
-    def line(cells: list[str]) -> str:
-        return "| " + " | ".join(cell.rjust(width) if right else cell.ljust(width)
-                                 for cell, width, right in zip(cells, widths, numeric)) + " |"
+    def lines(cells: list[str]) -> list[str]:
+        if widths is natural:
+            parts = [[cell] for cell in cells]
+        else:
+            parts = [_wrap(cell, size) for cell, size in zip(cells, widths)]
+        height = max(len(part) for part in parts)
+        return ["| " + " | ".join((part[at] if at < len(part) else "").rjust(size) if right
+                                  else (part[at] if at < len(part) else "").ljust(size)
+                                  for part, size, right in zip(parts, widths, numeric)) + " |"
+                for at in range(height)]
 
-    rule = "+" + "+".join("-" * (width + 2) for width in widths) + "+"
-    out = [table.title] if table.title else []
-    out += [rule, line(list(table.columns)), rule, *(line(row) for row in rows), rule]
+    rule = "+" + "+".join("-" * (size + 2) for size in widths) + "+"
+    out = [printable(table.title)] if table.title else []
+    out += [rule, *lines(list(table.columns)), rule, *(line for row in rows for line in lines(row)), rule]
     if table.caption:
-        out.append(table.caption)
+        out.append(printable(table.caption))
     return "\n".join(out) + "\n"
+
+
+def _wrap(text: str, size: int) -> list[str]:
+    import textwrap
+
+    return textwrap.wrap(text, size, break_on_hyphens=False) or [""]
+
+
+def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room: int) -> list[int] | None:
+    """Column widths that fit ``room`` characters of cells: the long text columns capped at one
+    common width (the widest shrink first), the others whole; None when that cap is too small."""
+    if sum(natural) <= room:
+        return natural
+    flexible = [index for index, column in enumerate(table.columns)
+                if column not in table.nowrap_columns and column not in table.numeric_columns
+                and column != table.status_column and natural[index] > 16]
+    left = room - sum(size for index, size in enumerate(natural) if index not in flexible)
+    count = len(flexible)
+    for size in sorted(natural[index] for index in flexible):
+        if size * count > left:
+            break
+        left -= size
+        count -= 1
+    if not count or left // count < MIN_WRAPPED_WIDTH:
+        return None
+    cap = left // count
+    return [min(size, cap) if index in flexible else size for index, size in enumerate(natural)]
+
+
+def plain_blocks(table: Table, rows: list[list[str]], width: int) -> str:
+    """One block per row for a narrow width: the short cells on one line, each long cell below it,
+    indented and wrapped (as :func:`render_rows_as_blocks` does on a terminal)."""
+    short = _short_columns(table, rows)
+    out = [printable(table.title)] if table.title else []
+    for row in rows:
+        out.append("  ".join(row[index] for index in short if row[index]))
+        for index, column in enumerate(table.columns):
+            if index not in short and row[index]:
+                out += ["    " + line for line in _wrap(f"{column}: {row[index]}", max(width - 4, MIN_WRAPPED_WIDTH))]
+    if table.caption:
+        out.append(printable(table.caption))
+    return "\n".join(out) + "\n"
+
+
+def _short_columns(table: Table, rows: list[list[str]]) -> list[int]:
+    """The columns a block puts on its first line: never wrapped, or at most 16 characters."""
+    return [index for index, column in enumerate(table.columns)
+            if column in table.nowrap_columns or column in table.numeric_columns or column == table.status_column
+            or max((len(row[index]) for row in rows), default=0) <= 16]
 
 
 NARROW_TERMINAL = 100
@@ -125,11 +233,9 @@ def render_rows_as_blocks(table: Table, out) -> None:
     from rich.text import Text
 
     rows = [[format_cell(value) for value in row] for row in table.rows]
-    short = [index for index, column in enumerate(table.columns)
-             if column in table.nowrap_columns or column in table.numeric_columns or column == table.status_column
-             or max((len(row[index]) for row in rows), default=0) <= 16]
+    short = _short_columns(table, rows)
     if table.title:
-        out.print(Text(table.title, style="bold"))
+        out.print(Text(printable(table.title), style="bold"))
     for row in rows:
         out.print(Text("  ".join(row[index] for index in short if row[index])))
         for index, column in enumerate(table.columns):
@@ -137,12 +243,12 @@ def render_rows_as_blocks(table: Table, out) -> None:
                 out.print(Padding(Text(f"{column}: {row[index]}"), (0, 0, 0, 4)))
 
 
-def render_table(table: Table, out=None) -> None:
+def render_table(table: Table, out=None, wide: bool = False) -> None:
     """Print one :class:`Table`: through rich on a terminal (as blocks when it is narrow), as
-    :func:`plain_table` elsewhere."""
+    :func:`plain_table` elsewhere and with ``wide``."""
     out = out or console()
-    if not out.is_terminal:
-        out.file.write(plain_table(table))
+    if wide or not out.is_terminal:
+        out.file.write(plain_table(table, table_width(out.file, wide)))
         out.file.flush()
         return
     if out.width < NARROW_TERMINAL and len(table.columns) > 3:
@@ -153,7 +259,7 @@ def render_table(table: Table, out=None) -> None:
     from rich.text import Text
 
     plain = out.no_color
-    rich_table = RichTable(title=table.title or None, caption=table.caption or None,
+    rich_table = RichTable(title=printable(table.title) or None, caption=printable(table.caption) or None,
                            box=box.ASCII2 if plain else box.ROUNDED, title_justify="left",
                            caption_justify="left", header_style="" if plain else "bold")
     for column in table.columns:
@@ -216,21 +322,23 @@ def render_report(report: Report, fmt: OutputFormat | str) -> None:
     if report.text:
         write(sys.stdout, report.text)
     stream = sys.stderr if report.text else sys.stdout
-    if not report.renderables and not stream.isatty():
+    if not report.renderables and (report.wide or not stream.isatty()):
         # What render_table would print off a terminal, without creating a console: importing rich
         # costs ~25 ms of every piped run.
-        write(stream, "".join([*map(plain_table, report.tables), *(line + "\n" for line in report.lines)]))
+        width = table_width(stream, report.wide)
+        write(stream, "".join([*(plain_table(table, width) for table in report.tables),
+                               *(printable(line) + "\n" for line in report.lines)]))
         return
     out = console(stderr=bool(report.text))
     for table in report.tables:
-        render_table(table, out)
+        render_table(table, out, report.wide)
     for renderable in report.renderables:
         out.print()
         out.print(renderable)
     if report.renderables:
         out.print()
     for line in report.lines:
-        out.print(line, markup=False)
+        out.print(printable(line), markup=False)
 
 
 def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:
@@ -240,10 +348,10 @@ def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:
 
     render_report(report, fmt)
     for error in report.errors:
-        write(sys.stderr, f"ar3cli: error: {error}\n")
+        write(sys.stderr, f"ar3cli: error: {printable(error)}\n")
     raise typer.Exit(EXIT_USAGE if report.errors else 0 if report.ok else 1)
 
 
 def log(message: str) -> None:
     """A progress/log line on stderr (never on stdout, which may carry JSON)."""
-    print(message, file=sys.stderr, flush=True)
+    print(printable(message), file=sys.stderr, flush=True)

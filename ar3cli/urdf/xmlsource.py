@@ -124,6 +124,10 @@ def parse(data: bytes, path: Path):
 
 
 _PREFIXED_TAG = re.compile(rb"<([A-Za-z_][\w.-]*):[A-Za-z_]")
+_PREFIXED_ATTRIBUTE = re.compile(rb""":[A-Za-z_][\w.-]*\s*=\s*["']""")
+"""The ``:name="`` of a prefixed attribute; starting at the colon lets the regex engine skip to each
+``:`` (rare outside URIs, which this does not match) instead of trying every whitespace."""
+_PREFIX_BEFORE = re.compile(rb"\s([A-Za-z_][\w.-]*)$")
 _DECLARED = re.compile(rb"""xmlns:([A-Za-z_][\w.-]*)\s*=""")
 _ROOT_TAG = re.compile(rb"<robot\b")
 UNDECLARED_NAMESPACE = "urn:ar3cli:undeclared:"
@@ -131,26 +135,43 @@ UNDECLARED_NAMESPACE = "urn:ar3cli:undeclared:"
 
 
 def _declare_undeclared_prefixes(data: bytes, quirks: list[Quirk]) -> bytes:
-    """Declare on ``<robot>`` the element prefixes the file uses without an ``xmlns:`` for them.
+    """Declare on ``<robot>`` the element and attribute prefixes the file uses without an ``xmlns:``
+    for them.
 
-    Drake's URDFs write ``<drake:proximity_properties>`` with no declaration: XML namespaces make
-    that "not well-formed", yet PyBullet and urdfdom read the file (they ignore namespaces). The
-    prefix is declared in the parsed copy only (quirk ``undeclared-prefix``, lint's F005 warns);
-    the source bytes and every line number stay as they are.
+    Drake's URDFs write ``<drake:proximity_properties>`` and ``<limit drake:acceleration="2.5"/>``
+    with no declaration: XML namespaces make that "not well-formed", yet PyBullet and urdfdom read
+    the file (they ignore namespaces). The prefix is declared in the parsed copy only (quirk
+    ``undeclared-prefix`` at the first use, lint's F005 warns); the source bytes and every line
+    number stay as they are.
     """
-    used = set(_PREFIXED_TAG.findall(data)) - {b"xml", b"xmlns"}
-    missing = sorted(used - set(_DECLARED.findall(data)))
+    first_use: dict[bytes, int] = {}
+    for match in _PREFIXED_TAG.finditer(data):
+        first_use.setdefault(match.group(1), match.start())
+    for match in _PREFIXED_ATTRIBUTE.finditer(data):
+        before = _PREFIX_BEFORE.search(data, max(0, match.start() - 200), match.start())
+        if before and _inside_a_tag(data, match.start()):
+            prefix, start = before.group(1), before.start(1)
+            first_use[prefix] = min(first_use.get(prefix, start), start)
+    declared = set(_DECLARED.findall(data)) | {b"xml", b"xmlns"}
+    missing = sorted(set(first_use) - declared)
     root = _ROOT_TAG.search(data)
     if not missing or root is None:
         return data
     names = ", ".join(prefix.decode("ascii", "replace") for prefix in missing)
-    line = data.count(b"\n", 0, data.find(b"<" + missing[0] + b":")) + 1
+    line = data.count(b"\n", 0, min(first_use[prefix] for prefix in missing)) + 1
     quirks.append(Quirk("undeclared-prefix", f"namespace prefix {names} is used but never declared (xmlns:...): "
                                              "PyBullet and urdfdom read the file, namespace-aware XML tools "
                                              "(lxml, ROS 2 launch, xacro) refuse it", line))
     declarations = b"".join(b" xmlns:" + prefix + b'="' + UNDECLARED_NAMESPACE.encode() + prefix + b'"'
                             for prefix in missing)
     return data[:root.end()] + declarations + data[root.end():]
+
+
+def _inside_a_tag(data: bytes, offset: int) -> bool:
+    """Whether ``offset`` is inside a start tag (``<name ...``), not in text, a comment or a
+    processing instruction: the last ``<`` before it comes after the last ``>`` and opens an element."""
+    opening = data.rfind(b"<", 0, offset)
+    return opening > data.rfind(b">", 0, offset) and data[opening + 1:opening + 2].isalpha()
 
 
 def _end_of_root(data: bytes, exc) -> int | None:
