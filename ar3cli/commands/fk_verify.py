@@ -11,6 +11,9 @@ from ar3cli.commands.options import (
     RobotPathArgument,
     SeedOption,
     XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
     samples_option,
 )
 from ar3cli.errors import UserError
@@ -35,6 +38,8 @@ def fk_verify(
     format: FormatOption = OutputFormat.text,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    xacro: XacroModeOption = XacroMode.safe,
+    xacro_env: XacroEnvOption = None,
 ) -> None:
     """Check that PyBullet (and your DH table) put every link frame where the URDF says.
 
@@ -49,7 +54,7 @@ def fk_verify(
     if not (tolerance_m > 0 and tolerance_rad > 0):
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
     tolerance = Tolerance(tolerance_m, tolerance_rad)
-    model = load_with_specs(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
     table = dh_module.load_dh(dh, model) if dh is not None else None
     drawn, comparison = measure(model, samples, seed, announce=format is OutputFormat.text)
     checked = check_dh(table, dh, drawn, comparison, tolerance) if table is not None and dh is not None else None
