@@ -83,15 +83,36 @@ def _check(value: Any) -> Any:
         return value
     if isinstance(value, int):
         return _int_result(value)
-    if isinstance(value, (str, list, tuple, dict, range)):
+    if isinstance(value, (str, range)):
         if len(value) > MAX_ITEMS:
             raise Refused(f"a {type(value).__name__} of {len(value)} items (the limit is {MAX_ITEMS})")
+        return value
+    if isinstance(value, (list, tuple, dict)):
+        if _weight(value) > MAX_ITEMS:  # nested repetitions share items: count what str() would write
+            raise Refused(f"a {type(value).__name__} of more than {MAX_ITEMS} items, nested ones counted")
         return value
     if isinstance(value, (Function, Namespace)):
         return value
     if _is_table(value):
         return value
     raise Refused(f"a value of type {type(value).__name__}")
+
+
+def _weight(value: Any) -> int:
+    """Items and characters in ``value`` counting every nested occurrence (stops past :data:`MAX_ITEMS`)."""
+    total, stack = 0, [value]
+    while stack and total <= MAX_ITEMS:
+        item = stack.pop()
+        if isinstance(item, dict):
+            total += len(item)
+            stack.extend(item.keys())
+            stack.extend(item.values())
+        elif isinstance(item, (list, tuple)):
+            total += len(item)
+            stack.extend(item)
+        elif isinstance(item, str):
+            total += len(item)
+    return total
 
 
 def _is_table(value: Any) -> bool:

@@ -126,8 +126,8 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
         result = run_isolated(work, str(path))
     except CrashError as exc:
         if exc.signal_name in ("SIGALRM", "SIGXCPU", "SIGKILL"):
-            raise UserError(f"{path}: xacro error: expansion stopped after its {WALL_SECONDS} s / {CPU_SECONDS} s CPU "
-                            "limit (a macro that calls itself many times, or a huge expression?)") from None
+            raise UserError(f"{path}: xacro error: expansion stopped at its limit of {WALL_SECONDS} s "
+                            f"({CPU_SECONDS} s of CPU): a macro that calls itself many times?") from None
         raise UserError(f"{path}: xacro error: the expansion died ({exc.signal_name})") from None
     for line in result.notes:
         log(f"ar3cli: note: {path}: xacro says: {line}")
