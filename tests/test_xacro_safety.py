@@ -209,7 +209,8 @@ def test_unknown_names_and_bad_expressions_fail_as_in_python():
 # --- the same robot in both modes, arguments --------------------------------------------------------
 
 @pytest.mark.parametrize("fixture", [REPO / "tests" / "data" / "xacro" / "arm.urdf.xacro",
-                                     REPO / "assets" / "ar3" / "ar3.urdf.xacro"])
+                                     REPO / "assets" / "ar3" / "ar3.urdf.xacro",
+                                     REPO / "tests" / "data" / "xacro_features" / "features.urdf.xacro"])
 def test_fixtures_expand_identically_in_both_modes(fixture):
     assert _expand(fixture) == _expand(fixture, policy=XacroPolicy(trusted=True))
 
