@@ -331,6 +331,18 @@ def _bounded_factorial(value: int) -> int:
     return math.factorial(value)
 
 
+def _round(value: Any, ndigits: Any = None) -> Any:
+    if isinstance(ndigits, int) and abs(ndigits) > 1000:  # round(1, -10**9) builds 10**(10**9)
+        raise Refused(f"round() to {ndigits} digits")
+    return round(value) if ndigits is None else round(value, ndigits)
+
+
+def _sum(items: Any, start: Any = 0) -> Any:
+    if not isinstance(start, (int, float)):  # sum(lists, []) is quadratic
+        raise Refused("sum() of anything but numbers")
+    return sum(items, start)
+
+
 def _callable_argument(function: Any) -> Callable[..., Any]:
     if not isinstance(function, Function):
         raise Refused(f"passing a {type(function).__name__} as a function")
@@ -359,7 +371,7 @@ BUILTINS: dict[str, Any] = {
     "True": True, "False": False,
     **{name: Function(name, function) for name, function in (
         ("list", list), ("dict", dict), ("len", len), ("str", str), ("float", float), ("int", int), ("bool", bool),
-        ("min", min), ("max", max), ("round", round), ("abs", abs), ("sum", sum), ("tuple", tuple),
+        ("min", min), ("max", max), ("round", _round), ("abs", abs), ("sum", _sum), ("tuple", tuple),
         ("sorted", _sorted), ("range", _bounded_range), ("map", _map), ("zip", lambda *items: list(zip(*items))),
         ("any", any), ("all", all))},
 }
