@@ -11,6 +11,9 @@ from ar3cli.commands.options import (
     RobotPathArgument,
     SeedOption,
     XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
     finite_float,
     samples_option,
 )
@@ -41,6 +44,8 @@ def fk_verify(
     format: FormatOption = OutputFormat.text,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    xacro: XacroModeOption = XacroMode.safe,
+    xacro_env: XacroEnvOption = None,
 ) -> None:
     """Check that PyBullet (and your DH table) put every link frame where the URDF says.
 
@@ -56,7 +61,7 @@ def fk_verify(
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
     tolerance = (Tolerance(DEFAULT_TOLERANCE_M, tolerance_rad, scaled=True) if tolerance_m is None
                  else Tolerance(tolerance_m, tolerance_rad))
-    model = load_with_specs(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
     table = dh_module.load_dh(dh, model) if dh is not None else None
     drawn, comparison = measure(model, samples, seed, announce=format is OutputFormat.text)
     checked = check_dh(table, dh, drawn, comparison, tolerance) if table is not None and dh is not None else None

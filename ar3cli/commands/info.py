@@ -12,6 +12,9 @@ from ar3cli.commands.options import (
     RobotPathArgument,
     SeedOption,
     XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
     samples_option,
 )
 from ar3cli.errors import UserError
@@ -37,6 +40,8 @@ def info(
     png: PngOption = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    xacro: XacroModeOption = XacroMode.safe,
+    xacro_env: XacroEnvOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
     """Show what a robot is made of: kinematic tree, DOF and joint limits, masses and centre of mass,
@@ -56,7 +61,7 @@ def info(
     def zero_frames(model):
         return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
 
-    model = load_with_specs(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
     summary = summarize(model, zero_frames)
     check = None
     if torques:

@@ -6,7 +6,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import PackagePathOption, XacroArgOption
+from ar3cli.commands.options import PackagePathOption, XacroArgOption, XacroEnvOption, XacroMode, XacroModeOption
 from ar3cli.errors import EXIT_USAGE, UserError
 from ar3cli.output.report import Report, Table, finish
 
@@ -90,6 +90,8 @@ def lint_urdf(
                                                         "exit; takes no PATH.", show_default=False)] = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    xacro: XacroModeOption = XacroMode.safe,
+    xacro_env: XacroEnvOption = None,
     srdf: Annotated[Optional[Path], typer.Option(
         "--srdf", metavar="FILE.srdf", dir_okay=False,
         help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
@@ -113,6 +115,7 @@ def lint_urdf(
     from ar3cli.lint.config import LintConfig, load_config
     from ar3cli.lint.engine import LintOptions, lint_paths, summarize
     from ar3cli.lint.rules import validate_patterns
+    from ar3cli.urdf.loading import apply_xacro_options
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_expand import parse_xacro_args
 
@@ -126,6 +129,7 @@ def lint_urdf(
             srdf_disabled=_srdf_disabled(srdf, sim))
     except ValueError as exc:
         raise UserError(str(exc)) from None
+    apply_xacro_options(xacro is XacroMode.trusted, xacro_env)
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
     fmt = LintFormat(format)
     accepted = None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from enum import Enum
 from pathlib import Path
 from typing import Annotated, Any, Optional
 
@@ -23,6 +24,28 @@ PackagePathOption = Annotated[
 XacroArgOption = Annotated[
     Optional[list[str]],
     typer.Option("--xacro-arg", metavar="NAME:=VALUE", help="A xacro argument for .xacro inputs (repeatable)."),
+]
+
+
+class XacroMode(str, Enum):
+    """How ``.xacro`` inputs are expanded (``docs/security.md``)."""
+
+    safe = "safe"
+    trusted = "trusted"
+
+
+XacroModeOption = Annotated[
+    XacroMode,
+    typer.Option("--xacro", help="How .xacro inputs are expanded. safe: expressions without Python eval, files only "
+                                 "from the robot's folder and packages, no environment variables, time and memory "
+                                 "limits. trusted: xacro as it is, which runs any Python the file holds; only for "
+                                 "your own files on your own machine."),
+]
+XacroEnvOption = Annotated[
+    Optional[list[str]],
+    typer.Option("--xacro-env", metavar="NAME",
+                 help="An environment variable .xacro inputs may read with $(env NAME) / $(optenv NAME) in safe "
+                      "mode (repeatable; without it they are refused)."),
 ]
 SeedOption = Annotated[int, typer.Option("--seed", min=0, max=2**32 - 1,
                                          help="Random seed (0 .. 2^32-1); the same seed gives the same output.")]

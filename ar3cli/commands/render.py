@@ -5,7 +5,16 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption, finite_float
+from ar3cli.commands.options import (
+    FormatOption,
+    PackagePathOption,
+    RobotPathArgument,
+    XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
+    finite_float,
+)
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 from ar3cli.urdf.loading import load_with_specs
 
@@ -26,6 +35,8 @@ def render_command(
                                          help="Camera pitch, degrees (negative looks down).")] = -20.0,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    xacro: XacroModeOption = XacroMode.safe,
+    xacro_env: XacroEnvOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
     """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.
@@ -36,7 +47,7 @@ def render_command(
     from ar3cli.pictures.render import draw_robot, parse_configuration
 
     configuration = parse_configuration(config)
-    model = load_with_specs(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
     result = draw_robot(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
                   show_collision=collision, warn=log)
     tables = []

@@ -137,13 +137,9 @@ def _used_files(path: Path, package_paths: Mapping[str, Path] | None,
                 xacro_args: Mapping[str, str] | None) -> set[str]:
     """Real paths of the files the robot file uses: its meshes (where found, or every place tried
     when missing) and, for xacro, every file xacro read. Empty when it cannot be loaded."""
-    import sys
-
     from ar3cli.urdf.model import load_model
-    from ar3cli.urdf.xacro_expand import is_xacro, origins
+    from ar3cli.urdf.xacro_expand import included_files, is_xacro, origins
 
-    xacro = sys.modules.get("xacro")
-    before = len(getattr(xacro, "all_includes", ())) if xacro is not None else 0
     try:
         model = load_model(path, package_paths, xacro_args)
     except (UserError, RecursionError):
@@ -154,7 +150,6 @@ def _used_files(path: Path, package_paths: Mapping[str, Path] | None,
         if resolution is not None:
             used += [str(resolution.path)] if resolution.path is not None else list(resolution.tried)
     if is_xacro(path):
-        xacro = sys.modules.get("xacro")
-        used += [str(name) for name in getattr(xacro, "all_includes", [])[before:]]  # what xacro --deps lists
+        used += included_files(model.xml_bytes)  # what xacro --deps lists
         used += [origin.file for origin in origins(model.xml_bytes) or [] if origin is not None]
     return {os.path.realpath(name) for name in used}

@@ -12,10 +12,24 @@ if TYPE_CHECKING:
     from ar3cli.urdf.model import Model
 
 
-def load_with_specs(path: Path, package_specs: list[str] | None, xacro_specs: list[str] | None) -> Model:
+def apply_xacro_options(trusted: bool, env_names: list[str] | None) -> None:
+    """Make ``--xacro trusted`` and ``--xacro-env NAME`` the policy of this run's expansions
+    (:func:`~ar3cli.urdf.xacro_expand.set_policy`); a malformed name raises UserError."""
+    from ar3cli.urdf.xacro_expand import set_policy
+    from ar3cli.urdf.xacro_safe import XacroPolicy
+
+    names = [name.strip() for name in env_names or []]
+    for name in names:
+        if not name or "=" in name or "$" in name or " " in name:
+            raise UserError(f"--xacro-env expects an environment variable name, got {name!r}")
+    set_policy(XacroPolicy(trusted=trusted, env=frozenset(names)))
+
+
+def load_with_specs(path: Path, package_specs: list[str] | None, xacro_specs: list[str] | None,
+                    xacro_trusted: bool = False, xacro_env: list[str] | None = None) -> Model:
     """Parse the package-path and xacro-argument specs and load the model; malformed specs raise
-    UserError (exit 2). The loaders are imported here, not at start-up: every command module
-    imports this one."""
+    UserError (exit 2). ``xacro_trusted`` / ``xacro_env`` are ``--xacro trusted`` and ``--xacro-env``.
+    The loaders are imported here, not at start-up: every command module imports this one."""
     from ar3cli.urdf.model import load_model
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_expand import parse_xacro_args
@@ -25,4 +39,5 @@ def load_with_specs(path: Path, package_specs: list[str] | None, xacro_specs: li
         xacro_args = parse_xacro_args(xacro_specs)
     except ValueError as exc:
         raise UserError(str(exc)) from None
+    apply_xacro_options(xacro_trusted, xacro_env)
     return load_model(path, packages, xacro_args)

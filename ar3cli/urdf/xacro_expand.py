@@ -1,4 +1,8 @@
-"""Expand ``.xacro`` files in-process with the ``xacro`` package.
+"""Expand ``.xacro`` files with the ``xacro`` package, in a child process with limits.
+
+Safe mode (the default) evaluates expressions without Python's ``eval`` and reads only the robot's
+own files (:mod:`ar3cli.urdf.xacro_safe`); ``--xacro trusted`` runs xacro as it is. Either way
+the expansion runs in a forked child with CPU, memory and wall-clock limits (:func:`expand`).
 
 No ROS installation is needed: ``$(find NAME)`` is answered by the same
 :class:`~ar3cli.urdf.packages.PackageResolver` that resolves ``package://`` URIs, and ``$(arg ...)``
@@ -18,12 +22,15 @@ from __future__ import annotations
 import contextlib
 import io
 import os
+import re
 from pathlib import Path
 from typing import NamedTuple
 
 from ar3cli.errors import UserError
+from ar3cli.infra.safe_read import MAX_FILE_BYTES
 from ar3cli.output.report import log
 from ar3cli.urdf.packages import PackageResolver
+from ar3cli.urdf.xacro_safe import ReadRoots, XacroPolicy, read_inside, safe_hooks
 
 
 def is_xacro(path: Path) -> bool:
@@ -55,68 +62,209 @@ ORIGIN_ATTRIBUTE = "ar3cli-origin"
 """The attribute that carries an element's origin through xacro (taken off before the output)."""
 _KEEP_ORIGINS = 4
 """Expansions whose origins are kept: a file is linted right after it is expanded."""
-_origins: dict[bytes, list[Origin | None]] = {}
+_origins: dict[bytes, tuple[list[Origin | None], list[str]]] = {}
 
 
 def origins(xml_bytes: bytes) -> list[Origin | None] | None:
     """The origin of each element of an expansion :func:`expand` returned, in document order
     (None for an element xacro made itself, such as ``xacro:element``); None for other bytes."""
-    return _origins.get(xml_bytes)
+    kept = _origins.get(xml_bytes)
+    return kept[0] if kept is not None else None
+
+
+def set_policy(policy: XacroPolicy) -> None:
+    """How the following expansions run (``--xacro``, ``--xacro-env``); set once by the command."""
+    global _policy
+    _policy = policy
+
+
+def current_policy() -> XacroPolicy:
+    """The policy :func:`expand` uses now (safe mode unless a command chose otherwise)."""
+    return _policy
+
+
+_policy = XacroPolicy()
+
+WALL_SECONDS = 30
+"""Wall-clock limit of one expansion; the largest real robot seen expands in under 2 s."""
+CPU_SECONDS = 20
+"""CPU-time limit of one expansion (``RLIMIT_CPU``)."""
+MEMORY_BYTES = 1024 * 1024 * 1024
+"""Address space an expansion may add to what the process already maps (``RLIMIT_AS``)."""
+
+
+class _Expansion(NamedTuple):
+    """What the child sends back: the URDF, its elements' origins, the files xacro read, xacro's chatter."""
+
+    data: bytes
+    found: list[Origin | None]
+    included: list[str]
+    notes: list[str]
 
 
 def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes:
-    """Return the expanded URDF as UTF-8 bytes (and keep its elements' :func:`origins`).
+    """Return the expanded URDF as UTF-8 bytes (and keep its elements' :func:`origins` and
+    :func:`included_files`).
+
+    The expansion runs in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`) with CPU,
+    memory and wall-clock limits, under the current policy (safe mode by default,
+    :mod:`ar3cli.urdf.xacro_safe`): a hostile file costs at most :data:`WALL_SECONDS` and is one
+    line. xacro is imported here first, so the child does not import it again.
+    """
+    import xacro  # noqa: F401 - imported before the fork: every expansion's child has it
+
+    from ar3cli.infra.isolation import CrashError, run_isolated
+
+    policy, parent = _policy, os.getpid()
+
+    def work() -> _Expansion:
+        if os.getpid() != parent:  # in the child (where fork is missing, the work runs here: no limits)
+            _limit_this_process()
+        return _expand_here(path, args, resolver, policy)
+
+    try:
+        result = run_isolated(work, str(path))
+    except CrashError as exc:
+        if exc.signal_name in ("SIGALRM", "SIGXCPU", "SIGKILL"):
+            raise UserError(f"{path}: xacro error: expansion stopped at its limit of {WALL_SECONDS} s "
+                            f"({CPU_SECONDS} s of CPU): a macro that calls itself many times?") from None
+        raise UserError(f"{path}: xacro error: the expansion died ({exc.signal_name})") from None
+    for line in result.notes:
+        log(f"ar3cli: note: {path}: xacro says: {line}")
+    while len(_origins) >= _KEEP_ORIGINS:
+        del _origins[next(iter(_origins))]
+    _origins[result.data] = (result.found, result.included)
+    return result.data
+
+
+def included_files(xml_bytes: bytes) -> list[str]:
+    """The files xacro read (includes, YAML) for an expansion :func:`expand` returned, as xacro named them."""
+    kept = _origins.get(xml_bytes)
+    return list(kept[1]) if kept is not None else []
+
+
+def _limit_this_process() -> None:
+    """In the expansion's child: die by SIGALRM after :data:`WALL_SECONDS`, SIGXCPU after
+    :data:`CPU_SECONDS` of CPU, get MemoryError past :data:`MEMORY_BYTES` more address space."""
+    import resource
+    import signal
+
+    signal.signal(signal.SIGALRM, signal.SIG_DFL)
+    signal.alarm(WALL_SECONDS)
+    with contextlib.suppress(ValueError, OSError):
+        resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+        resource.setrlimit(resource.RLIMIT_CPU, (CPU_SECONDS, CPU_SECONDS + 1))
+        with open("/proc/self/statm") as handle:
+            mapped = int(handle.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+        hard = resource.getrlimit(resource.RLIMIT_AS)[1]
+        wanted = mapped + MEMORY_BYTES
+        resource.setrlimit(resource.RLIMIT_AS, (wanted if hard == resource.RLIM_INFINITY else min(wanted, hard), hard))
+
+
+def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, policy: XacroPolicy) -> _Expansion:
+    """The expansion itself, in this process.
 
     xacro keeps module-level state and prints diagnostics with ``print``; both are contained
-    here: its ``$(find)`` hook and its ``parse`` are swapped for ours for the duration of the call,
-    and anything it prints is kept off stdout (stdout may be carrying JSON).
+    here: its ``$(find)`` hook and its ``parse`` are swapped for ours (and, in safe mode, its
+    evaluation, YAML loading and environment lookups: :func:`~ar3cli.urdf.xacro_safe.safe_hooks`)
+    for the duration of the call, and anything it prints is kept off stdout (stdout may be
+    carrying JSON).
     """
     import xacro
     from xacro import substitution_args
 
-    not_found: list[UserError] = []  # xacro wraps what the hook raises; keep ours to re-raise it as is
+    failures: list[UserError] = []  # xacro wraps what the hooks raise; keep ours to re-raise them as they are
+    roots = ReadRoots(path, list(resolver.package_paths.values()))
 
     def find_package(name: str) -> str:
         folder, tried = resolver.find_package(name)
         if folder is None:
-            not_found.append(UserError(f"{path}: $(find {name}): package not found; tried {', '.join(tried)}; "
-                                       f"pass --package-path {name}=DIR"))
-            raise not_found[-1]
+            failures.append(UserError(f"{path}: $(find {name}): package not found; tried {', '.join(tried)}; "
+                                      f"pass --package-path {name}=DIR"))
+            raise failures[-1]
+        roots.add_package(folder)
         return str(folder)
 
     table: list[Origin] = []
     kept: dict = {}
     original_find, original_parse = substitution_args._eval_find, xacro.parse
     substitution_args._eval_find = find_package
-    xacro.parse = _parse_with_origins(original_parse, table, kept)
+    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots)
     chatter = io.StringIO()
+    included_before = len(xacro.all_includes)
     try:
-        with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter):
+        with contextlib.redirect_stdout(chatter), contextlib.redirect_stderr(chatter), \
+                safe_hooks(policy, roots, failures):
             document = xacro.process_file(str(path), mappings=dict(args))
             found = _take_origins(document, table, kept)
             text = document.toprettyxml(indent="  ")
-    except UserError:
-        raise
+    except UserError as exc:
+        raise _located(exc, path) from None
     except Exception as exc:  # noqa: BLE001 - xacro raises many types: XacroException, NameError, XML errors...
-        if not_found:
-            raise not_found[-1] from None
+        if failures:
+            raise _located(failures[-1], path) from None
+        if _caused_by(exc, MemoryError):
+            raise UserError(f"{path}: xacro error: the expansion needs more than {MEMORY_BYTES >> 20} MB "
+                            "of memory") from None
         if isinstance(exc, RecursionError):
             raise UserError(f"{path}: xacro error: macro recursion too deep") from None
-        raise UserError(f"{path}: xacro error: {_one_line(exc)}") from None
+        raise UserError(f"{path}: xacro error: {_one_line(exc)}{_arguments_hint(path, args)}") from None
     finally:
         substitution_args._eval_find = original_find
         xacro.parse = original_parse
-    for line in chatter.getvalue().splitlines():
-        if line.strip() and not line.startswith("when processing file:"):
-            log(f"ar3cli: note: {path}: xacro says: {line.strip()}")
     data = text.encode("utf-8")
-    while len(_origins) >= _KEEP_ORIGINS:
-        del _origins[next(iter(_origins))]
-    _origins[data] = found
-    return data
+    if len(data) > MAX_FILE_BYTES:
+        raise UserError(f"{path}: xacro error: the expanded URDF is {len(data) / 1e6:.0f} MB, larger than the "
+                        f"{MAX_FILE_BYTES >> 20} MB limit for robot descriptions")
+    notes = [line.strip() for line in chatter.getvalue().splitlines()
+             if line.strip() and not line.startswith("when processing file:")]
+    return _Expansion(data, found, [str(name) for name in xacro.all_includes[included_before:]], notes)
 
 
-def _parse_with_origins(original_parse, table: list[Origin], kept: dict):
+def _located(exc: UserError, path: Path) -> UserError:
+    """A refusal from a hook, naming the linted file (and, when it is another, the file xacro was reading)."""
+    if exc.message.startswith(f"{path}:"):
+        return exc
+    location = _xacro_location()
+    where = f" (in {location})" if location and location != str(path) else ""
+    return UserError(f"{path}: xacro error: {exc.message}{where}", exc.exit_code)
+
+
+def _caused_by(exc: BaseException, kind: type[BaseException]) -> bool:
+    seen: set[int] = set()
+    stack: list[BaseException | None] = [exc]
+    while stack:
+        item = stack.pop()
+        if item is None or id(item) in seen:
+            continue
+        seen.add(id(item))
+        if isinstance(item, kind):
+            return True
+        stack += [getattr(item, "exc", None), item.__cause__, item.__context__]
+    return False
+
+
+_ARG_DECLARATION = re.compile(r"<xacro:arg\b[^>]*?\bname\s*=\s*[\"']([^\"']+)[\"']")
+_ARG_USE = re.compile(r"\$\(arg\s+([^\s)]+)\s*\)")
+
+
+def _arguments_hint(path: Path, given: dict[str, str]) -> str:
+    """When the file takes xacro arguments the user did not give: which, and how to give them."""
+    from ar3cli.infra.safe_read import read_bytes
+
+    try:
+        text = read_bytes(path).decode("utf-8", "replace")
+    except UserError:
+        return ""
+    names = [name for name in dict.fromkeys(_ARG_DECLARATION.findall(text) + _ARG_USE.findall(text))
+             if name not in given]
+    if not names:
+        return ""
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    return f"; the file takes xacro arguments ({shown}): pass the ones it needs with --xacro-arg NAME:=VALUE"
+
+
+def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None):
     """xacro's ``parse(inp, filename)``, noting the origin of each element read from a file.
 
     The file is read as xacro reads it (text, default encoding) and parsed by the builder
@@ -126,7 +274,9 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict):
     stays the same node up to the output, and ``kept`` maps it to its origin (no attribute for
     xacro to evaluate: 3 ms less on the AR3). xacro's own elements are left alone (xacro checks
     their attributes); inside ``xacro:if``/``xacro:unless`` nodes are moved, never copied.
+    With ``roots`` (safe mode), an existing file is read only inside them, through the capped reader.
     """
+    import locale
     from xml.dom import expatbuilder
 
     class Builder(expatbuilder.ExpatBuilderNS):
@@ -165,8 +315,12 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict):
 
         if inp is not None or filename is None:
             return original_parse(inp, filename)
+        full = os.path.join(getattr(xacro, "root_dir", os.curdir), filename)
+        if roots is not None and os.path.lexists(full):
+            text = read_inside(roots, full).decode(locale.getpreferredencoding(False))  # as open() decodes
+            return Builder(str(filename)).parseString(text)
         try:
-            with open(os.path.join(getattr(xacro, "root_dir", os.curdir), filename)) as handle:
+            with open(full) as handle:
                 text = handle.read()
         except OSError:
             return original_parse(inp, filename)  # raises xacro's own error, with its file stack
