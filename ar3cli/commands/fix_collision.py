@@ -4,7 +4,15 @@ from typing import Annotated
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FollowSymlinksOption,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+)
 from ar3cli.output.report import OutputFormat
 
 
@@ -28,6 +36,7 @@ def fix_collision(
     diff: DiffOption = False,
     check: CheckOption = False,
     output: OutputOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
@@ -55,7 +64,8 @@ def fix_collision(
                                staging=Path(tempfile.mkdtemp(prefix="ar3cli-parts-")))
     try:
         code = run_fixer("fix-collision", paths, make_fixer(options), diff=diff, check=check, output=output,
-                         fmt=format, package_path=package_path, verifier=verify_in_pybullet if verify else None)
+                         fmt=format, package_path=package_path,
+                         follow_symlinks=follow_symlinks, verifier=verify_in_pybullet if verify else None)
     except BaseException:
         options.rollback()  # part files of a URDF that was not rewritten
         raise

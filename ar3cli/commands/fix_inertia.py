@@ -5,7 +5,15 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FollowSymlinksOption,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+)
 from ar3cli.output.report import OutputFormat
 
 
@@ -29,6 +37,7 @@ def fix_inertia(
     diff: DiffOption = False,
     check: CheckOption = False,
     output: OutputOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
@@ -56,5 +65,5 @@ def fix_inertia(
     names = [name.strip() for name in links.split(",") if name.strip()] if links is not None else None
     options = InertiaOptions(names, all_links, density, parse_masses(mass), total_mass, include_implausible)
     code = run_fixer("fix-inertia", paths, make_fixer(options), diff=diff, check=check, output=output, fmt=format,
-                     package_path=package_path)
+                     package_path=package_path, follow_symlinks=follow_symlinks)
     raise typer.Exit(code)
