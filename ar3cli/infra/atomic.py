@@ -67,7 +67,7 @@ def check_writable(path: Path, follow_symlinks: bool = False) -> Path:
     if path.is_symlink():
         target = os.path.realpath(path)
         if not follow_symlinks:
-            raise UserError(f"{path}: is a symbolic link (to {target}); ar3cli does not write through links: "
+            raise UserError(f"{path}: is a symbolic link (to {target}); refusing to write through it: "
                             f"remove it, or give {FOLLOW_HINT} to write {target}")
         path = Path(target)
     else:
