@@ -277,6 +277,11 @@ class _Replacement:
             path.unlink(missing_ok=True)
             if path in created:
                 created.remove(path)
+        for folder in {path.parent for path in self.files}:
+            if folder in created:  # made for these parts alone: remove it when nothing else is in it
+                _remove_empty(folder)
+                if not folder.exists():
+                    created.remove(folder)
 
 
 def _summary_notes(plan: FixPlan, path: Path, options: CollisionOptions) -> None:
