@@ -13,7 +13,7 @@ from pathlib import Path
 import pytest
 
 from ar3cli.fix.edits import Document
-from ar3cli.infra.atomic import TEMP_MARKER, atomic_write, stale_temps
+from ar3cli.infra.atomic import TEMP_MARKER, atomic_write, stale_temps, temp_files
 from ar3cli.urdf.model import load_model
 from tests.conftest import ASSETS, REPO
 
@@ -172,23 +172,22 @@ def test_kill_mid_write_leaves_the_old_file(tmp_path):
     process = subprocess.Popen([sys.executable, "-m", "ar3cli", "fix-continuous", str(target), "--no-verify"],
                                env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 60
-    while not stale_temps(tmp_path) and time.monotonic() < deadline:
+    while not temp_files(tmp_path) and time.monotonic() < deadline:
         time.sleep(0.01)
     time.sleep(0.5)  # a few chunks in
     process.send_signal(signal.SIGKILL)
     process.wait()
-    temps = stale_temps(tmp_path)
+    temps = stale_temps(tmp_path)  # its pid is gone: stale
     assert len(temps) == 1 and 0 < temps[0].stat().st_size < len(old)  # really killed mid-write
     assert target.read_bytes() == old
-    temps[0].unlink()
-    # the same run, not killed, gives the new file and no temp
+    # the same run, not killed, gives the new file and removes the dead run's temp
     env.pop("AR3CLI_TEST_SLOW_WRITE")
     subprocess.run([sys.executable, "-m", "ar3cli", "fix-continuous", str(target), "--no-verify"], env=env,
                    check=True, capture_output=True)
     assert b'lower="-100"' not in target.read_bytes() and stale_temps(tmp_path) == []
 
 
-def test_atomic_write_follows_symlinks_and_refuses_directories(tmp_path):
+def test_atomic_write_follows_symlinks_when_asked_and_refuses_directories(tmp_path):
     import pytest
 
     from ar3cli.errors import UserError
@@ -197,7 +196,10 @@ def test_atomic_write_follows_symlinks_and_refuses_directories(tmp_path):
     real.write_bytes(b"old")
     link = tmp_path / "link.urdf"
     link.symlink_to(real)
-    atomic_write(link, b"new")
+    with pytest.raises(UserError, match="--follow-symlinks"):
+        atomic_write(link, b"new")
+    assert real.read_bytes() == b"old"
+    atomic_write(link, b"new", follow_symlinks=True)
     assert link.is_symlink() and real.read_bytes() == b"new"
     with pytest.raises(UserError, match="is a directory"):
         atomic_write(tmp_path, b"x")

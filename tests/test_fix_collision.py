@@ -239,3 +239,72 @@ def test_coacd_when_installed(cli, robot):
     assert result.code == 0, result.stderr
     row = json.loads(result.stdout)["files"][0]["collisions"][0]
     assert row["parts"] >= 2 and row["method"].startswith("coacd") and row["hull_ratio_after"] < 1.5
+
+
+NEIGHBOURS = """<?xml version="1.0"?>
+<robot name="u_and_peg">
+  <link name="base">
+    <inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+    <collision><origin xyz="0 0 -0.5"/><geometry><box size="0.02 0.02 0.02"/></geometry></collision>
+  </link>
+  <joint name="to_u" type="revolute">
+    <parent link="base"/><child link="u"/><axis xyz="0 0 1"/>
+    <limit lower="-0.1" upper="0.1" effort="1" velocity="1"/>
+  </joint>
+  <link name="u">
+    <inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+    <collision><geometry><mesh filename="meshes/u.stl"/></geometry></collision>
+  </link>
+  <joint name="to_peg" type="prismatic">
+    <parent link="base"/><child link="peg"/><axis xyz="{axis}"/>
+    <limit lower="0" upper="0.1" effort="1" velocity="1"/>
+  </joint>
+  <link name="peg">
+    <inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+    <collision><origin xyz="{x} 0.05 0.005"/><geometry><box size="0.02 0.02 0.01"/></geometry></collision>
+  </link>
+</robot>
+"""
+"""Two sibling links (not adjacent: both hang from ``base``, which has geometry of its own, far away): the U
+and a peg that slides away from it."""
+
+
+def neighbours(folder: Path, x: float, axis: str) -> Path:
+    (folder / "meshes").mkdir(parents=True)
+    voxel_mesh(U_CELLS).export(folder / "meshes" / "u.stl")
+    path = folder / "robot.urdf"
+    path.write_text(NEIGHBOURS.format(x=x, axis=axis), encoding="utf-8")
+    return path
+
+
+def test_a_decomposition_that_adds_a_home_contact_is_refused(cli, tmp_path):
+    """issue 30 item 5: the convex parts are hulls of a voxelised U and reach 0.7 mm past its surface
+    (vhacd at --resolution 20000); a peg 1.35 mm beside the U's outer face does not touch the original
+    (its hull, as PyBullet collides it) but would touch the parts at home. The U keeps its mesh."""
+    path = neighbours(tmp_path, 0.07 + 0.00135 + 0.01, "1 0 0")
+    before = path.read_bytes()
+    result = cli("fix-collision", str(path), *FAST, "--samples", "50", "--format", "json")
+    assert result.code == 1, result.stdout + result.stderr
+    (file,) = json.loads(result.stdout)["files"]
+    assert file["changes"] == [] and file["written"] is None
+    (skipped,) = file["skipped"]
+    assert skipped["element"] == "link u" and "decomposition refused" in skipped["reason"]
+    assert "peg and u touch at the home pose (the original meshes do not)" in skipped["reason"]
+    (row,) = [row for row in file["collisions"] if row["link"] == "u"]
+    assert row["action"].startswith("refused:") and row["files"] == []
+    assert path.read_bytes() == before and not (tmp_path / "collision").exists()  # no stray part files
+    text = cli("fix-collision", str(path), *FAST, "--samples", "50")
+    assert text.code == 1 and "decomposition refused" in text.stdout and "nothing written" in text.stdout
+
+
+def test_a_decomposition_that_frees_a_neighbour_is_accepted_and_the_table_says_what_was_compared(cli, tmp_path):
+    """A peg inside the U touches the U's hull at home (the original collides as its hull) and not the
+    parts: the pair collides less after the fix, which is the fix working."""
+    path = neighbours(tmp_path, 0.035, "0 1 0")
+    result = cli("fix-collision", str(path), *FAST, "--samples", "50", "--seed", "3")
+    assert result.code == 0, result.stdout + result.stderr
+    assert "verified in PyBullet" in result.stdout
+    assert "home contacts, original vs fixed" in result.stdout and "1 pair(s) touching at home before, 0 after" in result.stdout
+    assert "pair categories, original vs fixed" in result.stdout and "50 samples, seed 3" in result.stdout
+    assert "1 collide less (peg/u: default -> never)" in result.stdout and "none more" in result.stdout
+    assert "fail" not in result.stdout

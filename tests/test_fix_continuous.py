@@ -211,3 +211,68 @@ def test_a_read_only_second_input_stops_the_run_before_any_write(cli, tmp_path):
     result = cli("fix-continuous", str(first), str(second), "--no-verify")
     assert result.code == 2 and "is read-only" in result.stderr
     assert first.read_text() == BARE  # all or nothing
+
+
+UNLOADABLE = """<?xml version="1.0"?>
+<robot name="no_load">
+  <link name="base">
+    <inertial><origin xyz="0 0 0"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+  </link>
+  <joint name="spin" type="continuous">
+    <parent link="base"/><child link="wheel"/><axis xyz="0 0 1"/>
+    <limit lower="-3.14" upper="3.14" effort="1" velocity="1"/>
+  </joint>
+  <link name="wheel">
+    <inertial><mass value="0.5"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="0.001"/></inertial>
+  </link>
+</robot>
+"""
+"""A continuous joint with fake limits in a file pybullet refuses ("failed to parse link": base's
+``<inertial>`` has no ``<mass>``)."""
+
+
+def test_a_file_pybullet_cannot_load_is_never_called_verified(cli, tmp_path):
+    """issue 30 item 12: the fix was written and "verified in PyBullet" printed above a "fail" row.
+    The original does not load either, so the fix did not break loading: it is written, and the
+    verdict says it was not verified (exit 1), in agreement with its rows."""
+    path = tmp_path / "no_load.urdf"
+    path.write_text(UNLOADABLE, encoding="utf-8")
+    result = cli("fix-continuous", str(path))
+    assert result.code == 1, result.stdout + result.stderr
+    assert "verified in PyBullet" not in result.stdout and "checked in PyBullet: not verified" in result.stdout
+    assert "PyBullet cannot load the original either: not verified" in result.stdout
+    assert 'lower="-3.14"' not in path.read_text(encoding="utf-8")
+    path.write_text(UNLOADABLE, encoding="utf-8")
+    data = json.loads(cli("fix-continuous", str(path), "--format", "json").stdout)
+    (file,) = data["files"]
+    assert data["ok"] is False and file["written"] == str(path)
+    verification = file["verification"]
+    assert verification["status"] == "not verified" and verification["verified"] is False
+    assert [(row["element"], row["status"]) for row in verification["checks"]] == [("(the file)", "fail"),
+                                                                                 ("(the original)", "fail")]
+
+
+def test_a_fix_that_fails_its_pybullet_check_is_not_written(tmp_path, capsys):
+    """The verdict line agrees with the table, and a failed check keeps the original file."""
+    from ar3cli.fix.driver import Change, FixPlan, check_row, run_fixer
+    from ar3cli.output.report import OutputFormat
+
+    path = tmp_path / "robot.urdf"
+    original = (ASSETS / "examples" / "ar3_fake_continuous.urdf").read_bytes()
+    path.write_bytes(original)
+
+    def fixer(model, document):
+        joint = next(j for j in model.joints if j.type == "continuous")
+        element = joint.element.find("limit")
+        document.remove_attribute(document.span(element), "lower")
+        return FixPlan(changes=[Change(f"joint {joint.name}", joint.line, "limit lower", "x", None, "test")])
+
+    def verifier(model, plan):
+        return {"verified": False, "checks": [check_row("joint j", "limits", False, "made up for the test")]}
+
+    code = run_fixer("fix-continuous", [path], fixer, diff=False, check=False, output=None, fmt=OutputFormat.text,
+                     package_path=None, verifier=verifier)
+    out = capsys.readouterr().out
+    assert code == 1 and path.read_bytes() == original
+    assert "verified in PyBullet" not in out and "nothing written: the fixed file failed its check in PyBullet" in out
+    assert not [p for p in tmp_path.iterdir() if p.name != "robot.urdf"]  # no temporary file left

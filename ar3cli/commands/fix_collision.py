@@ -8,10 +8,13 @@ from ar3cli.commands.options import (
     CheckOption,
     DiffOption,
     FixPathsArgument,
+    FollowSymlinksOption,
     FormatOption,
     OutputOption,
     PackagePathOption,
+    SeedOption,
     finite_float,
+    samples_option,
 )
 from ar3cli.output.report import OutputFormat
 
@@ -32,11 +35,17 @@ def fix_collision(
         "--from-visual", help="Links with a `<visual>` but no `<collision>` get one: a primitive copied, a mesh "
                               "as its convex hull (decomposed when its hull ratio is above the limit).")] = False,
     verify: Annotated[bool, typer.Option(
-        "--verify/--no-verify", help="After writing, load the result in PyBullet and count each changed "
-                                     "link's collision shapes.")] = True,
+        "--verify/--no-verify", help="Compare the original and the fixed robot in PyBullet (home contacts and "
+                                     "sampled pair categories; a decomposition that makes a pair collide more "
+                                     "is refused), and after writing count each changed link's collision "
+                                     "shapes.")] = True,
+    samples: Annotated[int, samples_option("Configurations sampled to compare pair categories before and "
+                                           "after the fix.", 100_000)] = 300,
+    seed: SeedOption = 0,
     diff: DiffOption = False,
     check: CheckOption = False,
     output: OutputOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
@@ -61,13 +70,13 @@ def fix_collision(
         raise UserError(f"--max-hull-ratio {max_hull_ratio}: must be above 1 (a convex mesh is 1)")
     options = CollisionOptions(max_hull_ratio=max_hull_ratio, method=resolve_method(method), resolution=resolution,
                                from_visual=from_visual, output=output, write=not diff and not check,
+                               follow_symlinks=follow_symlinks, compare=verify, samples=samples, seed=seed,
                                staging=Path(tempfile.mkdtemp(prefix="ar3cli-parts-")))
     try:
         code = run_fixer("fix-collision", paths, make_fixer(options), diff=diff, check=check, output=output,
-                         fmt=format, package_path=package_path, verifier=verify_in_pybullet if verify else None)
-    except BaseException:
-        options.rollback()  # part files of a URDF that was not rewritten
-        raise
+                         fmt=format, package_path=package_path,
+                         follow_symlinks=follow_symlinks, verifier=verify_in_pybullet if verify else None)
     finally:
+        options.rollback()  # part files of a URDF that was not rewritten (an error, a failed check)
         remove_staging(options)
     raise typer.Exit(code)

@@ -9,6 +9,7 @@ from ar3cli.commands.options import (
     CheckOption,
     DiffOption,
     FixPathsArgument,
+    FollowSymlinksOption,
     FormatOption,
     OutputOption,
     PackagePathOption,
@@ -44,6 +45,7 @@ def fix_inertia(
     diff: DiffOption = False,
     check: CheckOption = False,
     output: OutputOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
@@ -72,5 +74,5 @@ def fix_inertia(
     names = [name.strip() for name in links.split(",") if name.strip()] if links is not None else None
     options = InertiaOptions(names, all_links, density, parse_masses(mass), total_mass, include_implausible)
     code = run_fixer("fix-inertia", paths, make_fixer(options), diff=diff, check=check, output=output, fmt=format,
-                     package_path=package_path)
+                     package_path=package_path, follow_symlinks=follow_symlinks)
     raise typer.Exit(code)

@@ -9,6 +9,7 @@ from ar3cli.commands.options import (
     CheckOption,
     DiffOption,
     FixPathsArgument,
+    FollowSymlinksOption,
     FormatOption,
     OutputOption,
     PackagePathOption,
@@ -33,6 +34,7 @@ def fix_joints(
     diff: DiffOption = False,
     check: CheckOption = False,
     output: OutputOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
@@ -55,5 +57,6 @@ def fix_joints(
     limits = read_joint_limits(limits_from) if limits_from is not None else None
     options = JointsOptions(effort, velocity, limits, limits_from)
     code = run_fixer("fix-joints", paths, make_fixer(options), diff=diff, check=check, output=output,
-                     fmt=format, package_path=package_path, verifier=verify_in_pybullet if verify else None)
+                     fmt=format, package_path=package_path,
+                     follow_symlinks=follow_symlinks, verifier=verify_in_pybullet if verify else None)
     raise typer.Exit(code)

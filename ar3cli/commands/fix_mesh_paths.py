@@ -4,7 +4,15 @@ from typing import Annotated
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FollowSymlinksOption,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+)
 from ar3cli.output.report import OutputFormat
 
 
@@ -20,6 +28,7 @@ def fix_mesh_paths(
     diff: DiffOption = False,
     check: CheckOption = False,
     output: OutputOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
 ) -> None:
@@ -37,6 +46,6 @@ def fix_mesh_paths(
     packages = parse_packages(package)
     specs = [f"{name}={folder}" for name, folder in packages.items()] + list(package_path or [])
     code = run_fixer("fix-mesh-paths", paths, make_fixer(MeshPathOptions(packages)), diff=diff, check=check,
-                     output=output, fmt=format, package_path=specs,
+                     output=output, fmt=format, package_path=specs, follow_symlinks=follow_symlinks,
                      verifier=verify_in_pybullet if verify else None)
     raise typer.Exit(code)

@@ -7,7 +7,12 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from ar3cli.commands.options import FormatOption, SeedOption, finite_float
+from ar3cli.commands.options import (
+    FollowSymlinksOption,
+    FormatOption,
+    SeedOption,
+    finite_float,
+)
 from ar3cli.errors import UserError
 from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 
@@ -29,6 +34,7 @@ def grasp_demo(
                                                  help="Squeeze force per finger in N (at most the model's "
                                                       "finger effort, 30 N). Low values make the "
                                                       "grasp slip.")] = 20.0,
+    follow_symlinks: FollowSymlinksOption = False,
     format: FormatOption = OutputFormat.text,
 ) -> None:
     """Pick up the cube with the AR3: approach, descend, close, lift 10 cm, hold 1 s.
@@ -59,7 +65,7 @@ def grasp_demo(
     if record is not None:
         from ar3cli.pictures.recording import GifRecorder, check_gif_path
 
-        check_gif_path(record)
+        record = check_gif_path(record, follow_symlinks)
         recorder = GifRecorder(**demo_camera(seed, settings))
     result = run_grasp(seed, settings, gui=gui, frame_hook=recorder)
     data = result.to_dict()

@@ -7,6 +7,7 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.commands.options import (
+    FollowSymlinksOption,
     FormatOption,
     PackagePathOption,
     RobotPathArgument,
@@ -38,6 +39,7 @@ def info(
     samples: SamplesOption = 200,
     seed: SeedOption = 0,
     png: PngOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
@@ -56,7 +58,7 @@ def info(
     from ar3cli.kinematics.fk import urdf_link_frames
 
     if png is not None:
-        _check_png(png)
+        png = _check_png(png, follow_symlinks)
 
     def zero_frames(model):
         return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
@@ -77,10 +79,10 @@ def info(
                   picture=None if png is None else str(png)), format)
 
 
-def _check_png(png: Path) -> None:
-    """Refuse an unusable --png before any work."""
+def _check_png(png: Path, follow_symlinks: bool) -> Path:
+    """Refuse an unusable --png before any work; the file to write (a link's target with --follow-symlinks)."""
     from ar3cli.infra.atomic import check_writable
 
     if png.suffix.lower() != ".png":
         raise UserError(f"--png {png}: the file name must end in .png")
-    check_writable(png)
+    return check_writable(png, follow_symlinks)

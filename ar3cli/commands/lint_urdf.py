@@ -6,8 +6,18 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import PackagePathOption, XacroArgOption, XacroEnvOption, XacroMode, XacroModeOption
-from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.commands.options import (
+    FollowSymlinksOption,
+    PackagePathOption,
+    XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
+)
+from ar3cli.errors import (
+    EXIT_USAGE,
+    UserError,
+)
 from ar3cli.output.report import Report, Table, finish
 
 
@@ -80,6 +90,7 @@ def lint_urdf(
                                                            help="Write every finding of this run to FILE as the "
                                                                 "baseline (for --baseline) and exit 0.",
                                                            show_default=False)] = None,
+    follow_symlinks: FollowSymlinksOption = False,
     changed_since: Annotated[Optional[str], typer.Option("--changed-since", metavar="REF",
                                                          help="Only the robot files under PATH changed since this "
                                                               "git ref (and untracked ones), and those using a "
@@ -150,7 +161,7 @@ def lint_urdf(
     if no_files:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     if write_baseline is not None:
-        _write_baseline(write_baseline, results, fmt)
+        _write_baseline(write_baseline, results, fmt, follow_symlinks)
     held = None
     if accepted is not None:
         from ar3cli.lint.baseline import apply_baseline
@@ -196,11 +207,11 @@ def _srdf_disabled(srdf: Path | None, sim: bool) -> frozenset[frozenset[str]]:
     return disabled_pairs(srdf)
 
 
-def _write_baseline(path: Path, results, fmt: LintFormat) -> None:
+def _write_baseline(path: Path, results, fmt: LintFormat, follow_symlinks: bool = False) -> None:
     """Write the baseline, say so in one line (or a JSON object), exit 0 (2 if a file's check crashed)."""
     from ar3cli.lint.baseline import write_baseline
 
-    count, files = write_baseline(path, results)
+    count, files = write_baseline(path, results, follow_symlinks)
     line = (f"wrote {path}: {count} finding{'s' if count != 1 else ''} in {files} file{'s' if files != 1 else ''} "
             f"({len(results)} checked); with --baseline {path} only new findings are reported")
     data = {"baseline": str(path), "findings": count, "files_with_findings": files, "files": len(results)}

@@ -104,3 +104,7 @@ CheckOption = Annotated[bool, typer.Option("--check", help="Write nothing; exit 
 OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_default=False,
                                                       help="Write the result to FILE instead of in place "
                                                            "(one input only).")]
+FollowSymlinksOption = Annotated[bool, typer.Option(
+    "--follow-symlinks", help="Write through an output path (or an in-place fix's file) that is a symbolic link, "
+                              "replacing the link's target. Without it such a path is refused: a link planted "
+                              "in a repository must not redirect a write.")]

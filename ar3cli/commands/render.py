@@ -6,6 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.commands.options import (
+    FollowSymlinksOption,
     FormatOption,
     PackagePathOption,
     RobotPathArgument,
@@ -15,7 +16,13 @@ from ar3cli.commands.options import (
     XacroModeOption,
     finite_float,
 )
-from ar3cli.output.report import OutputFormat, Report, Table, finish, log
+from ar3cli.output.report import (
+    OutputFormat,
+    Report,
+    Table,
+    finish,
+    log,
+)
 from ar3cli.urdf.loading import load_with_specs
 
 
@@ -33,6 +40,7 @@ def render_command(
     yaw: Annotated[float, typer.Option(click_type=finite_float(), help="Camera yaw around the robot, degrees.")] = 45.0,
     pitch: Annotated[float, typer.Option(click_type=finite_float(),
                                          help="Camera pitch, degrees (negative looks down).")] = -20.0,
+    follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
@@ -44,8 +52,10 @@ def render_command(
     Links in contact with a link they are not joined to are drawn red: the problem `lint-urdf --sim` reports.
     No display or GPU is needed.
     """
+    from ar3cli.infra.atomic import check_writable
     from ar3cli.pictures.render import draw_robot, parse_configuration
 
+    output = check_writable(output, follow_symlinks)  # before any work; a planted link is refused
     configuration = parse_configuration(config)
     model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
     result = draw_robot(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,

@@ -6,6 +6,7 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.commands.options import (
+    FollowSymlinksOption,
     FormatOption,
     PackagePathOption,
     RobotPathArgument,
@@ -64,6 +65,7 @@ def sample_collisions(
     srdf_compare: SrdfCompareOption = None,
     pybullet_filter: FilterOption = None,
     png: PngOption = None,
+    follow_symlinks: FollowSymlinksOption = False,
     format: FormatOption = OutputFormat.text,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
@@ -86,7 +88,7 @@ def sample_collisions(
     if srdf_merge is not None and srdf is None:
         raise UserError(f"--srdf-merge {srdf_merge}: give --srdf OUT for the merged SRDF (the same path "
                         "updates the file in place)")
-    _check_outputs(srdf, pybullet_filter, png)
+    _check_outputs(srdf, pybullet_filter, png, follow_symlinks)
     existing, document = _read_for_merge(srdf_merge) if srdf_merge is not None else (None, None)
     reference = None
     if srdf_compare is not None:
@@ -100,15 +102,15 @@ def sample_collisions(
     if srdf is not None and existing is not None:
         merged = srdf_files.merge(existing, document, run.results, comment)
         merged.target = srdf
-        _write(srdf, merged.data)
+        _write(follow_symlinks, srdf, merged.data)
     elif srdf is not None:
-        _write(srdf, srdf_files.srdf_bytes(model.name or "robot", run.results, comment))
+        _write(follow_symlinks, srdf, srdf_files.srdf_bytes(model.name or "robot", run.results, comment))
     if pybullet_filter is not None:
-        _write(pybullet_filter, cm.pybullet_filter_bytes(run.results, comment))
+        _write(follow_symlinks, pybullet_filter, cm.pybullet_filter_bytes(run.results, comment))
     if png is not None:
         from ar3cli.collisions.heatmap_png import heat_map_png
 
-        _write(png, heat_map_png(run.links, run.pairs, run.results,
+        _write(follow_symlinks, png, heat_map_png(run.links, run.pairs, run.results,
                                  title=f"{model.name or model.path.name}: {samples} samples, seed {seed}"))
     comparison = None
     if reference is not None:
@@ -131,7 +133,8 @@ def _read_for_merge(path: Path):
     return existing, document
 
 
-def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | None) -> None:
+def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | None,
+                   follow_symlinks: bool) -> None:
     """Refuse unusable output paths before minutes of sampling, not after."""
     from ar3cli.infra.atomic import check_writable
 
@@ -139,10 +142,10 @@ def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | 
         raise UserError(f"--png {png}: the file name must end in .png")
     for target in (srdf, pybullet_filter, png):
         if target is not None:
-            check_writable(target)
+            check_writable(target, follow_symlinks)
 
 
-def _write(path: Path, data: bytes) -> None:
+def _write(follow_symlinks: bool, path: Path, data: bytes) -> None:
     from ar3cli.infra.atomic import atomic_write
 
-    atomic_write(path, data)
+    atomic_write(path, data, follow_symlinks=follow_symlinks)

@@ -40,6 +40,9 @@ own links measure 1.1 to 1.6 (blocky castings); a U or L whose hull doubles its 
 as a solid block where half of it is air."""
 PARTS_FOLDER = "collision"
 """Folder beside the written URDF that holds ``<link>/part_NN.obj``."""
+VERIFY_SAMPLES = 300
+"""Configurations sampled (``--seed``-ed) to compare every pair's category before and after the fix:
+enough to see a pair that starts colliding often, few enough to keep the check to seconds."""
 _UNSAFE = re.compile(r"[^A-Za-z0-9_.-]+")
 _PART_FILE = re.compile(r"part_(\d+)\.obj$")
 
@@ -60,6 +63,12 @@ class CollisionOptions:
     originals: dict[Path, bytes] = field(default_factory=dict)
     decompositions: dict = field(default_factory=dict)
     """Raw decompositions by mesh file and parameters (:func:`~ar3cli.fix.decompose.decompose`'s cache)."""
+    follow_symlinks: bool = False
+    """Write a symlinked URDF's target (``--follow-symlinks``); part folders never leave the URDF's folder."""
+    compare: bool = False
+    """Compare the original and the fixed robot in PyBullet before accepting a replacement."""
+    samples: int = VERIFY_SAMPLES
+    seed: int = 0
 
     def rollback(self) -> None:
         """Remove the part files of every URDF that was not rewritten (the run failed before it)."""
@@ -128,24 +137,42 @@ class _Writer:
             index += 1
         return names
 
-    def write(self, link: str, names: list[str], texts: list[str]) -> None:
+    def write(self, link: str, names: list[str], texts: list[str]) -> list[Path]:
+        """Write the part files (atomically, never through a link); the paths written."""
+        from ar3cli.infra.atomic import atomic_write, check_writable
+
         folder = self._where(link)
         created = self.options.created.setdefault(self.target, [])
-        missing = [p for p in (folder.parent, folder) if not p.exists()]
+        if self.options.write and not created:  # the first file for this URDF: may it be rewritten at all?
+            check_writable(self.options.output or self.model.path, self.options.follow_symlinks)
+        missing = [p for p in (folder.parent, folder) if not p.exists() and not p.is_symlink()]
+        self._refuse_leaving(folder)
         try:
             folder.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
             raise UserError(f"{folder}: cannot create the folder for the parts: {exc.strerror or exc}") from None
+        self._refuse_leaving(folder)
         if self.options.write:
             created.extend(missing)
+        paths = []
         for name, text in zip(names, texts):
             path = folder / name
-            try:
-                path.write_text(text, encoding="utf-8")
-            except OSError as exc:
-                raise UserError(f"{path}: cannot write: {exc.strerror or exc}") from None
+            atomic_write(path, text.encode("utf-8"))
+            paths.append(path)
             if self.options.write:
                 created.append(path)
+        return paths
+
+    def _refuse_leaving(self, folder: Path) -> None:
+        """UserError when ``collision/`` or ``collision/<link>/`` is a link that leads out of the
+        URDF's folder (planted in a pull request, it would make ar3cli write anywhere)."""
+        if not self.options.write:
+            return  # the staging folder is ar3cli's own
+        home = Path(os.path.realpath(self.target.parent))
+        for step in (folder.parent, folder):
+            if step.is_symlink() and not Path(os.path.realpath(step)).is_relative_to(home):
+                raise UserError(f"{step}: is a symbolic link to {os.path.realpath(step)}, outside {home}; "
+                                "ar3cli writes part files only inside the URDF's folder: remove the link")
 
     def uri(self, link: str, name: str, old_uri: str | None, old_resolution) -> str:
         """The ``filename`` for a part: relative to the URDF, or package:// like the old one."""
@@ -164,8 +191,10 @@ class _Writer:
 def plan_collisions(model, document: Document, options: CollisionOptions) -> FixPlan:
     from ar3cli.fix.decompose import MeshProblem, measure
 
-    plan = FixPlan(context={"links": {}}, data={"collisions": []})
+    plan = FixPlan(context={"links": {}, "path": model.path}, data={"collisions": []})
     target = Path(os.path.realpath(options.output or model.path))
+    pending: list[_Replacement] = []
+    inserts: list = []
     options.originals.setdefault(target, target.read_bytes() if target.is_file() else b"")
     writer = _Writer(options, target, model)
     measures: dict[tuple[str, tuple], object] = {}
@@ -195,12 +224,64 @@ def plan_collisions(model, document: Document, options: CollisionOptions) -> Fix
             elif result.ratio <= options.max_hull_ratio:
                 row["action"] = "left alone: hull ratio within the limit"
             else:
-                _replace_collision(document, plan, writer, link, shape, result, row, options)
+                _replace_collision(document, plan, writer, link, shape, result, row, options, pending)
             plan.data["collisions"].append(row)
         if options.from_visual and not link.collisions and link.visuals:
-            _from_visuals(document, plan, writer, link, measured, options)
+            _from_visuals(document, plan, writer, link, measured, options, inserts)
+    if pending and options.compare and options.write:
+        from ar3cli.fix.collision_compare import accept_replacements
+
+        accepted = accept_replacements(model, target, pending, inserts, plan, options)
+    else:
+        accepted = pending
+    for insert in inserts:
+        insert(document)
+    for replacement in pending:
+        if replacement in accepted:
+            replacement.accept(document, plan)
+        else:
+            replacement.refuse(plan, options)
     _summary_notes(plan, model.path, options)
     return plan
+
+
+@dataclass
+class _Replacement:
+    """One collision mesh's decomposition, planned but not yet spliced: the comparison in PyBullet
+    may refuse it (the mesh then keeps its original collision)."""
+
+    link: str
+    line: int
+    row: dict
+    splice: tuple[int, int, bytes]
+    change: Change
+    uris: list[str]
+    note: str
+    files: list[Path]
+    refused_because: str = ""
+
+    def accept(self, document: Document, plan: FixPlan) -> None:
+        document.splice(*self.splice)
+        plan.changes.append(self.change)
+        plan.notes.append(self.note)
+        plan.context["links"][self.link] = self.uris
+        self.row.update(action="decomposed", files=self.uris)
+
+    def refuse(self, plan: FixPlan, options: CollisionOptions) -> None:
+        """Keep the original collision; remove the part files written for it."""
+        self.row.update(action=f"refused: {self.refused_because}", files=[])
+        plan.skipped.append(Skipped(f"link {self.link}", self.line, f"decomposition refused: {self.refused_because}; "
+                                    "the original collision mesh is kept"))
+        created = options.created.get(Path(os.path.realpath(options.output or plan.context["path"])), [])
+        for path in self.files:
+            path.unlink(missing_ok=True)
+            if path in created:
+                created.remove(path)
+        for folder in {path.parent for path in self.files}:
+            if folder in created:  # made for these parts alone: remove it when nothing else is in it
+                _remove_empty(folder)
+                if not folder.exists():
+                    created.remove(folder)
 
 
 def _summary_notes(plan: FixPlan, path: Path, options: CollisionOptions) -> None:
@@ -232,8 +313,9 @@ def _row(link, shape, result) -> dict:
 
 
 def _decompose(plan: FixPlan, writer: _Writer, link, shape, result, row: dict,
-               options: CollisionOptions) -> list[str] | None:
-    """Decompose one mesh, write its parts; the part file names, or None (reported as not fixed)."""
+               options: CollisionOptions) -> tuple[list[str], list[Path]] | None:
+    """Decompose one mesh, write its parts; the part file names and paths, or None (reported as
+    not fixed). Its note (what the decomposition gained) is the last of ``plan.notes``."""
     from ar3cli.fix.decompose import decompose, obj_text
 
     geometry = shape.geometry
@@ -260,7 +342,7 @@ def _decompose(plan: FixPlan, writer: _Writer, link, shape, result, row: dict,
     texts = [obj_text(part.vertices, part.faces, f"ar3cli fix-collision: convex part {i + 1} of {len(parts)} "
                       f"of {path.name} ({decomposition.parameters})", name.removesuffix(".obj"))
              for i, (part, name) in enumerate(zip(parts, names))]
-    writer.write(link.name, names, texts)
+    files = writer.write(link.name, names, texts)
     row.update(parts=len(parts), hull_volume_after=decomposition.hull_volume,
                hull_ratio_after=decomposition.hull_volume / result.mesh_volume)
     took = "the parts computed above" if decomposition.reused else f"{decomposition.seconds:.2f} s"
@@ -268,14 +350,17 @@ def _decompose(plan: FixPlan, writer: _Writer, link, shape, result, row: dict,
                       f"{took}): hull volume {result.hull_volume:.4g} -> "
                       f"{decomposition.hull_volume:.4g} m^3 against a mesh volume of {result.mesh_volume:.4g} m^3 "
                       f"(hull/mesh {result.ratio:.3g} -> {row['hull_ratio_after']:.3g})")
-    return names
+    return names, files
 
 
 def _replace_collision(document: Document, plan: FixPlan, writer: _Writer, link, shape, result, row: dict,
-                       options: CollisionOptions) -> None:
-    names = _decompose(plan, writer, link, shape, result, row, options)
-    if names is None:
+                       options: CollisionOptions, pending: list[_Replacement]) -> None:
+    """Plan one ``<collision>``'s replacement by its parts (queued on ``pending``, spliced once accepted)."""
+    decomposed = _decompose(plan, writer, link, shape, result, row, options)
+    if decomposed is None:
         return
+    names, files = decomposed
+    note = plan.notes.pop()
     geometry = shape.geometry
     uris = [writer.uri(link.name, name, geometry.filename, geometry.resolution) for name in names]
     span = document.span(shape.element)
@@ -295,14 +380,12 @@ def _replace_collision(document: Document, plan: FixPlan, writer: _Writer, link,
             copy = copy[:start - span.start] + new + copy[end - span.start:]
         copies.append(copy)
     separator = document.newline + document.indentation(span)
-    document.splice(span.start, span.end, separator.join(copies))
-    row["action"] = "decomposed"
-    row["files"] = uris
-    plan.changes.append(Change(
+    change = Change(
         f"link {link.name}", row["line"], "collision mesh", f"{geometry.filename} (hull/mesh {result.ratio:.3g})",
         f"{len(uris)} parts {_folder_of(uris)} (hull/mesh {row['hull_ratio_after']:.3g})",
-        f"{row['method']}, {_took(row)}"))
-    plan.context["links"][link.name] = uris
+        f"{row['method']}, {_took(row)}")
+    pending.append(_Replacement(link.name, row["line"], row, (span.start, span.end, separator.join(copies)), change,
+                                uris, note, files))
 
 
 def _took(row: dict) -> str:
@@ -316,8 +399,9 @@ def _folder_of(uris: list[str]) -> str:
 
 
 def _from_visuals(document: Document, plan: FixPlan, writer: _Writer, link, measured,
-                  options: CollisionOptions) -> None:
-    """Collisions for a link with visuals only, inserted after its last <visual>."""
+                  options: CollisionOptions, inserts: list) -> None:
+    """Collisions for a link with visuals only, inserted after its last <visual> (queued on
+    ``inserts`` as a function of the Document, so the comparison can apply it to a scratch copy)."""
     from ar3cli.fix.decompose import MeshProblem, hull_part, obj_text, scale_factor
 
     lines: list[str] = []
@@ -345,9 +429,10 @@ def _from_visuals(document: Document, plan: FixPlan, writer: _Writer, link, meas
             row["action"] = f"not fixed: {result}"
             continue
         if result.ratio is not None and result.ratio > options.max_hull_ratio:
-            names = _decompose(plan, writer, link, shape, result, row, options)
-            if names is None:
+            decomposed = _decompose(plan, writer, link, shape, result, row, options)
+            if decomposed is None:
                 continue
+            names = decomposed[0]
             source = f"--from-visual, {row['method']}, {_took(row)}"
             what = f"{len(names)} parts (hull/mesh {result.ratio:.3g} -> {row['hull_ratio_after']:.3g})"
         else:
@@ -379,8 +464,12 @@ def _from_visuals(document: Document, plan: FixPlan, writer: _Writer, link, meas
                                    f"{what}: {_folder_of(uris)} from {geometry.filename}", source))
     if not lines:
         return
-    spans = [document.span(shape.element) for shape in link.visuals]
-    document.insert_child(document.span(link.element), lines, after=spans[-1])
+    last_visual = link.visuals[-1].element
+
+    def insert(target: Document) -> None:
+        target.insert_child(target.span(link.element), lines, after=target.span(last_visual))
+
+    inserts.append(insert)
     plan.context["links"][link.name] = uris_all or None
 
 
@@ -409,12 +498,21 @@ def remove_staging(options: CollisionOptions) -> None:
 # ---- verification in PyBullet -----------------------------------------------------------------
 def verify(model, plan: FixPlan) -> dict:
     """Load the written file in PyBullet (in a child); every changed link must have one collision
-    shape per ``<collision>``, the part files among them."""
+    shape per ``<collision>``, the part files among them. The rows of the comparison of the original
+    and the fixed robot (:mod:`ar3cli.fix.collision_compare`, made on these same bytes before the
+    write) are added, so the table says what was compared."""
+    from ar3cli.fix.collision_compare import comparison_rows
+
     links = plan.context.get("links", {})
     expected = {link.name: len(link.collisions) for link in model.links if link.name in links}
     files = {name: [str(Path(model.resolver.resolve(uri).path or uri).resolve()) for uri in uris or []]
              for name, uris in links.items()}
-    return verified_in_pybullet(model, lambda: _checks_in_pybullet(model, expected, files), nothing_changed=not links)
+    result = verified_in_pybullet(model, lambda: _checks_in_pybullet(model, expected, files), nothing_changed=not links)
+    rows = comparison_rows(plan.context.get("comparison")) if links else []
+    if not rows:
+        return result
+    return {**result, "checks": result["checks"] + rows,
+            "verified": result["verified"] and all(row["status"] == "ok" for row in rows)}
 
 
 def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[str]]) -> list[dict]:

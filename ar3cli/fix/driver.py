@@ -151,11 +151,15 @@ def refuse_xacro(paths: list[Path]) -> None:
 
 
 def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, check: bool, output: Path | None,
-              fmt: OutputFormat, package_path: list[str] | None, verifier: Verifier | None = None) -> int:
+              fmt: OutputFormat, package_path: list[str] | None, verifier: Verifier | None = None,
+              follow_symlinks: bool = False) -> int:
     """Run ``fixer`` on every path and report; returns the exit code.
 
     Every file is loaded and planned before the first write: a bad second input stops the run
-    with no file changed, instead of after the first one was rewritten.
+    with no file changed, instead of after the first one was rewritten. A symlinked input or
+    ``-o`` is refused unless ``follow_symlinks`` (see :func:`~ar3cli.infra.atomic.check_writable`);
+    an in-place write is refused when the file changed since it was read. With a ``verifier``, a
+    fix whose PyBullet check fails is not written (see :func:`settle_verification`).
     """
     from ar3cli.urdf.loading import load_with_specs
 
@@ -164,7 +168,7 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
     if output is not None and len(paths) != 1:
         raise UserError("-o/--output takes exactly one input file")
     refuse_xacro(paths)
-    planned: list[tuple[FixResult, bytes]] = []
+    planned: list[tuple[FixResult, bytes, Any]] = []
     for path in paths:
         model = load_with_specs(path, package_path, None)
         document = Document(model.source_bytes)
@@ -178,22 +182,69 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
             result.diff = unified_diff(path, model.source_bytes, new)
         if result.changed:
             result.remaining = remaining_findings(path, new, package_path)
-        planned.append((result, new))
-    if not diff and not check:
-        for result, _ in planned:
+        planned.append((result, new, model))
+    writing = not diff and not check
+    if writing:
+        for result, _, _ in planned:
             if result.changed or output is not None:
-                check_writable(output or result.path)
-    for result, new in planned:
+                check_writable(output or result.path, follow_symlinks)
+    for result, new, original in planned:
+        if not writing or not (result.changed or output is not None):
+            continue
         target = output or result.path
-        if not diff and not check and (result.changed or output is not None):
-            def validate(temp: Path, result: FixResult = result) -> None:
-                new_model = load_with_specs(temp, package_path, None)
-                if verifier is not None and result.plan.changes:
-                    result.verification = verifier(new_model, result.plan)
 
-            atomic_write(target, new, validate)
-            result.written = target
-    return _report(command, [result for result, _ in planned], diff=diff, check=check, fmt=fmt)
+        def validate(temp: Path, result: FixResult = result, original: Any = original) -> None:
+            new_model = load_with_specs(temp, package_path, None)
+            if verifier is not None and result.plan.changes:
+                result.verification = settle_verification(verifier(new_model, result.plan), original)
+                if result.verification["status"] == "failed":
+                    raise _VerificationFailed
+
+        try:
+            atomic_write(target, new, validate, follow_symlinks=follow_symlinks,
+                         expect=original.source_bytes if output is None else None)
+        except _VerificationFailed:
+            continue
+        result.written = target
+    return _report(command, [result for result, _, _ in planned], diff=diff, check=check, fmt=fmt)
+
+
+class _VerificationFailed(Exception):
+    """Raised inside the atomic write's validation: the temporary file is removed, the target kept."""
+
+
+def settle_verification(verification: dict[str, Any], original: Any) -> dict[str, Any]:
+    """Give a verifier's answer its ``status``: ``verified`` (every row ok), ``failed`` (a row
+    failed: the fix is not written), or ``not verified`` (pybullet cannot load the fixed file,
+    and cannot load the original either: the fix did not break loading, it is written, and the
+    output says it was not verified). The verdict always agrees with the rows."""
+    if verification.get("verified"):
+        return {**verification, "status": "verified"}
+    if "error" not in verification:
+        return {**verification, "status": "failed"}
+    reason = pybullet_load_error(original)
+    if reason is None:
+        return {**verification, "status": "failed"}
+    rows = [*verification["checks"], check_row("(the original)", "loaded", False, reason)]
+    return {**verification, "checks": rows, "status": "not verified",
+            "note": "PyBullet cannot load the original either: not verified"}
+
+
+def pybullet_load_error(model: Any) -> str | None:
+    """Why pybullet cannot load ``model`` (in a contained child), or None when it can."""
+    from ar3cli.sim.session import run_pybullet
+
+    def load() -> None:
+        from ar3cli.sim.session import Session
+
+        with Session() as session:
+            session.load(model, visuals=False, allow_nan_frames=True)
+
+    try:
+        run_pybullet(load, model)
+    except UserError as exc:
+        return exc.message.removeprefix(f"{model.path}: ")
+    return None
 
 
 def remaining_findings(path: Path, data: bytes, package_path: list[str] | None) -> dict[str, Any]:
@@ -259,7 +310,7 @@ def _diff_name(side: str, path: Path) -> str:
 def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, fmt: OutputFormat) -> int:
     needs_change = any(r.changed for r in results)
     skipped = any(r.plan.skipped for r in results)
-    failed_verify = any(r.verification and not r.verification.get("verified", True) for r in results)
+    failed_verify = any(r.verification and r.verification.get("status", "verified") != "verified" for r in results)
     mode = "diff" if diff else "check" if check else "write"
     code = EXIT_PROBLEMS if skipped or failed_verify or (check and needs_change) else EXIT_OK
     data = {"command": command, "mode": mode, "ok": code == EXIT_OK,
@@ -278,7 +329,8 @@ def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, 
     if skipped_rows:
         tables.append(Table("not fixed", ["file", "element", "line", "reason"], skipped_rows))
     if verify_rows:
-        tables.append(Table("verified in PyBullet", ["file", "element", "check", "status", "detail"], verify_rows,
+        title = "verified in PyBullet" if all(row[3] == "ok" for row in verify_rows) else "checked in PyBullet: not verified"
+        tables.append(Table(title, ["file", "element", "check", "status", "detail"], verify_rows,
                             status_column="status"))
     if len(results) == 1:  # the file is in the summary line; keep the table narrow
         for table in tables:
@@ -290,7 +342,10 @@ def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, 
         elif not r.changed:
             lines.append(f"{r.path}: nothing to change")
         elif r.written:
-            lines.append(f"{r.path}: {len(r.plan.changes)} field(s) changed, written to {r.written}")
+            lines.append(f"{r.path}: {len(r.plan.changes)} field(s) changed, written to {r.written}"
+                         + (f"; {r.verification['note']}" if r.verification and r.verification.get("note") else ""))
+        elif r.verification and r.verification.get("status") == "failed":
+            lines.append(f"{r.path}: nothing written: the fixed file failed its check in PyBullet (see above)")
         else:
             lines.append(f"{r.path}: {len(r.plan.changes)} field(s) would change")
         if r.remaining is not None:

@@ -53,9 +53,9 @@ def baseline_key(shown: str, folder: Path) -> str:
     return Path(relative).as_posix()
 
 
-def write_baseline(path: Path, results: list[LintResult]) -> tuple[int, int]:
-    """Write every finding of ``results`` to the baseline ``path`` (atomically); returns the
-    number of findings and of files that have some."""
+def write_baseline(path: Path, results: list[LintResult], follow_symlinks: bool = False) -> tuple[int, int]:
+    """Write every finding of ``results`` to the baseline ``path`` (atomically; a symlink only with
+    ``follow_symlinks``); returns the number of findings and of files that have some."""
     from ar3cli.infra.atomic import atomic_write
 
     folder = Path(os.path.abspath(path)).parent
@@ -73,7 +73,8 @@ def write_baseline(path: Path, results: list[LintResult]) -> tuple[int, int]:
     document = {"ar3cli-baseline": VERSION,
                 "fingerprint": "rule + message shape + quoted names; no line numbers",
                 "files": files}
-    atomic_write(Path(path), (json.dumps(document, indent=2, ensure_ascii=False) + "\n").encode("utf-8"))
+    atomic_write(Path(path), (json.dumps(document, indent=2, ensure_ascii=False) + "\n").encode("utf-8"),
+                 follow_symlinks=follow_symlinks)
     return sum(counts.values()), len(files)
 
 

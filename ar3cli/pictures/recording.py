@@ -16,11 +16,12 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.infra.atomic import atomic_write
+from ar3cli.infra.atomic import atomic_write, check_writable
 
 
-def check_gif_path(path: Path) -> Path:
-    """The output path, or UserError when it is not a writable ``.gif`` location."""
+def check_gif_path(path: Path, follow_symlinks: bool = False) -> Path:
+    """The file to write (a link's target with ``follow_symlinks``), or UserError when ``path`` is not
+    a writable ``.gif`` location (a symlink without ``follow_symlinks`` included)."""
     if path.suffix.lower() != ".gif":
         raise UserError(f"--record {path}: the file name must end in .gif")
     if path.is_dir():
@@ -30,7 +31,7 @@ def check_gif_path(path: Path) -> Path:
         raise UserError(f"--record {path}: folder {parent} does not exist")
     if not os.access(parent, os.W_OK):
         raise UserError(f"--record {path}: folder {parent} is not writable")
-    return path
+    return check_writable(path, follow_symlinks)
 
 
 class GifRecorder:
