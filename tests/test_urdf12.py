@@ -331,6 +331,24 @@ def test_fix_inertia_computes_the_capsule(cli, tmp_path):
     assert (axis, side) == pytest.approx((0.0007758490566037736, 0.010879622641509434), rel=1e-14)  # the fixture's
 
 
+def test_fix_inertia_turns_a_quaternion_inertial_origin_to_the_identity(cli, tmp_path):
+    """The tensor is written in the link frame: a quat_xyzw on the inertial origin must become 0 0 0 1 (left
+    alone, the Model and urdfdom would turn the new tensor by it; an added rpy would make urdfdom 1.1 refuse
+    an origin with both)."""
+    path = tmp_path / "capsule.urdf"
+    turned = '<origin xyz="0.1 0 0" quat_xyzw="0 0 0.3826834323650898 0.9238795325112867"/>'
+    text = CAPSULE.read_text().replace('<origin xyz="0.1 0 0" rpy="0 0 0"/>', turned)
+    path.write_text(text.replace('ixx="0.0007758490566037736"', 'ixx="0.5"'))  # breaks the triangle inequality
+    result = cli("fix-inertia", str(path), "--format", "json")
+    assert result.code == 0, result.stderr
+    fixed = path.read_text()
+    assert '<origin xyz="0.1 0 0" quat_xyzw="0 0 0 1"/>' in fixed and fixed.count("rpy=") == text.count("rpy=")
+    inertial = load_model(path).link("rod").inertial
+    np.testing.assert_allclose(inertial.origin.rotation, np.eye(3), atol=0)
+    np.testing.assert_allclose(inertial.matrix(), np.diag((0.0007758490566037736, 0.010879622641509434,
+                                                           0.010879622641509434)), rtol=1e-6)
+
+
 # ---- G010 -------------------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("declared,reported", [
