@@ -87,18 +87,8 @@ def _positive(value: float | None) -> bool:
 
 
 def capsule(radius: float, length: float) -> mp.MassProperties:
-    """Unit-density capsule along z: a cylinder of ``length`` plus two hemispherical caps.
-
-    A hemisphere of mass m has its COM 3r/8 from the flat face and ``I_axis = 2 m r^2 / 5``,
-    ``I_perp = 83 m r^2 / 320`` about its own COM; the caps are moved to the capsule centre with
-    the parallel-axis theorem by :func:`mass_properties.combine`.
-    """
-    cylinder = mp.cylinder(radius, length, density=1.0) if length > 0 else None
-    half_mass = 2.0 / 3.0 * math.pi * radius**3
-    axis, perp = 0.4 * half_mass * radius**2, 83.0 / 320.0 * half_mass * radius**2
-    offset = length / 2 + 3.0 * radius / 8.0
-    caps = [mp.MassProperties(half_mass, (0.0, 0.0, sign * offset), np.diag((perp, perp, axis))) for sign in (1, -1)]
-    return mp.combine([*caps, *([cylinder] if cylinder else [])])
+    """Unit-density capsule along z (:func:`ar3cli.physics.mass_properties.capsule`, closed form)."""
+    return mp.capsule(radius, length, density=1.0)
 
 
 def mesh_mass(shape: Shape, cache: dict) -> tuple[mp.MassProperties, str]:

@@ -276,8 +276,12 @@ def _write_inertial(document: Document, plan: FixPlan, link, props: mp.MassPrope
             plan.changes.append(Change(element, line, "origin xyz", None, xyz, geometry_source))
     else:
         _set(document, plan, origin, "xyz", xyz, element, geometry_source, same=_same_numbers)
-        _set(document, plan, origin, "rpy", "0 0 0", element, "tensor written in the link frame",
-             same=_same_numbers, default="0 0 0")
+        if origin.get("quat_xyzw") is None or origin.get("rpy") is not None:
+            _set(document, plan, origin, "rpy", "0 0 0", element, "tensor written in the link frame",
+                 same=_same_numbers, default="0 0 0")
+        if origin.get("quat_xyzw") is not None:  # URDF 1.1's orientation: the identity in its own form
+            _set(document, plan, origin, "quat_xyzw", "0 0 0 1", element, "tensor written in the link frame",
+                 same=_same_numbers)
     mass = inertial_element.find("mass")
     if mass is None:
         document.insert_child(inertial_span, [f"<mass {document.format_attr('value', number(props.mass)).decode()}/>"])

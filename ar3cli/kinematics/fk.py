@@ -3,7 +3,8 @@
 Two ways to place frames, both batched over N configurations (arrays of shape ``(N, 4, 4)``):
 
 - :func:`urdf_link_frames` walks the URDF tree of a :class:`~ar3cli.urdf.model.Model` the way the URDF
-  spec says: joint origin (xyz, then rpy as ``Rz(yaw) Ry(pitch) Rx(roll)``), then the motion about
+  spec says: joint origin (xyz, then rpy as ``Rz(yaw) Ry(pitch) Rx(roll)``, or URDF 1.1's normalised
+  ``quat_xyzw``: the Origin's exact rotation matrix), then the motion about
   the **normalised** axis (rotation for revolute/continuous, translation for prismatic); mimic
   joints take ``multiplier * q[mimicked] + offset``.
 - :func:`dh_frames` chains Denavit-Hartenberg rows, standard (``Rz Tz Tx Rx``) or modified/Craig
@@ -24,6 +25,7 @@ import numpy as np
 
 from ar3cli.errors import UserError
 from ar3cli.physics.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
+from ar3cli.physics.tensor_math import matrix_to_rpy
 from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, ROTATING_JOINT_TYPES, Joint, Model
 
@@ -32,11 +34,8 @@ SUPPORTED_TYPES = (*ACTUATED_JOINT_TYPES, "fixed")
 
 
 def matrix_rpy(rotation: np.ndarray) -> tuple[float, float, float]:
-    """Inverse of ``rpy_matrix`` (URDF rpy from a rotation; pitch in [-pi/2, pi/2])."""
-    pitch = float(np.arctan2(-rotation[2, 0], np.hypot(rotation[0, 0], rotation[1, 0])))
-    roll = float(np.arctan2(rotation[2, 1], rotation[2, 2]))
-    yaw = float(np.arctan2(rotation[1, 0], rotation[0, 0]))
-    return roll, pitch, yaw
+    """Inverse of ``rpy_matrix`` (URDF rpy from a rotation; pitch in [-pi/2, pi/2], exact at gimbal lock)."""
+    return matrix_to_rpy(rotation)
 
 
 def transform(xyz: Sequence[float] = (0.0, 0.0, 0.0), rpy: Sequence[float] = (0.0, 0.0, 0.0)) -> np.ndarray:
@@ -135,7 +134,9 @@ def urdf_link_frames(model: Model, positions: Mapping[str, np.ndarray], count: i
                             "revolute, continuous, prismatic and fixed joints")
         if joint.parent not in frames or joint.child is None:
             continue
-        origin = transform(joint.origin.xyz, joint.origin.rpy)
+        origin = np.eye(4)
+        origin[:3, :3] = joint.origin.rotation
+        origin[:3, 3] = joint.origin.xyz
         parent_origin = frames[joint.parent] @ origin
         if joint.type == "fixed":
             frames[joint.child] = parent_origin

@@ -9,7 +9,8 @@ Conventions (the same as URDF ``<inertial>``):
   ``<inertial>`` with ``<origin rpy="0 0 0" xyz="com"/>`` expresses, so a result can be
   written out without any further rotation.
 * Primitive shapes follow URDF geometry conventions: a box is centred on its origin, a
-  cylinder is centred on its origin with its axis along z, a sphere is centred.
+  cylinder is centred on its origin with its axis along z, a sphere is centred, and a capsule
+  (URDF 1.1) is a cylinder of ``length`` along z with a hemisphere of its radius on each end.
 * ``rpy`` angles follow URDF: fixed-axis roll about x, then pitch about y, then yaw about
   z, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
 
@@ -34,6 +35,8 @@ __all__ = [
     "MassProperties",
     "box",
     "box_volume",
+    "capsule",
+    "capsule_volume",
     "combine",
     "cylinder",
     "cylinder_volume",
@@ -105,6 +108,11 @@ def sphere_volume(radius: float) -> float:
     return 4.0 / 3.0 * math.pi * radius**3
 
 
+def capsule_volume(radius: float, length: float) -> float:
+    """Volume of a solid capsule: a cylinder of ``length`` plus a sphere of the same radius."""
+    return cylinder_volume(radius, length) + sphere_volume(radius)
+
+
 def box(size: ArrayLike, mass: float | None = None, density: float | None = None) -> MassProperties:
     """Solid box centred on the origin, edges along the axes (URDF ``<box size>``).
 
@@ -132,6 +140,23 @@ def sphere(radius: float, mass: float | None = None, density: float | None = Non
     m = _resolve_mass(sphere_volume(radius), mass, density)
     moment = 2.0 * m * radius**2 / 5.0
     return _at_origin(m, (moment, moment, moment))
+
+
+def capsule(radius: float, length: float, mass: float | None = None, density: float | None = None) -> MassProperties:
+    """Solid capsule centred on the origin, axis along z (URDF 1.1 ``<capsule>``, as urdfdom, PyBullet,
+    Drake and MuJoCo read it: ``length`` is the cylinder between the two hemispherical caps).
+
+    With ``m_c`` the cylinder's mass and ``m_h`` one cap's: ``I_zz = m_c r^2 / 2 + 4 m_h r^2 / 5``
+    and ``I_xx = I_yy = m_c (3 r^2 + l^2) / 12 + 2 m_h (2 r^2 / 5 + l^2 / 4 + 3 l r / 8)`` (a cap
+    has ``2 m_h r^2 / 5`` about a diameter of its flat face; its COM sits ``3 r / 8`` from that face,
+    and the parallel-axis theorem moves it to the capsule's centre). ``length`` 0 is a sphere.
+    """
+    m = _resolve_mass(capsule_volume(radius, length), mass, density)
+    share = m / capsule_volume(radius, length)  # the density, however the mass was given
+    m_c, m_h = share * cylinder_volume(radius, length), share * sphere_volume(radius) / 2.0
+    r2 = radius**2
+    side = m_c * (3.0 * r2 + length**2) / 12.0 + 2.0 * m_h * (0.4 * r2 + length**2 / 4.0 + 3.0 * length * radius / 8.0)
+    return _at_origin(m, (side, side, m_c * r2 / 2.0 + 0.8 * m_h * r2))
 
 
 def rpy_to_matrix(rpy: ArrayLike) -> np.ndarray:

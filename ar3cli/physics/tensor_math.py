@@ -15,7 +15,8 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-__all__ = ["is_positive_definite", "rpy_to_matrix", "satisfies_triangle_inequality", "symmetric_eigenvalues"]
+__all__ = ["is_positive_definite", "matrix_to_rpy", "quaternion_to_matrix", "rpy_to_matrix", "satisfies_triangle_inequality",
+           "symmetric_eigenvalues", "unit_quaternion"]
 
 Matrix3 = Sequence[Sequence[float]]
 NEAR_SINGULAR = 1e-4
@@ -138,3 +139,51 @@ def rpy_to_matrix(rpy: Sequence[float]) -> tuple[tuple[float, float, float], ...
     return ((cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr),
             (sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr),
             (-sp, cp * sr, cp * cr))
+
+
+def unit_quaternion(quat_xyzw: Sequence[float]) -> tuple[float, float, float, float] | None:
+    """``quat_xyzw`` (x, y, z, w: the order of URDF 1.1's ``<origin quat_xyzw>``) scaled to norm 1.
+
+    urdfdom normalises the quaternion it reads (urdfdom_headers ``Rotation::setFromQuaternion``);
+    None when it has no direction (all zeros) or holds a non-finite number, which urdfdom would turn
+    into the identity or into NaN frames and the linter reports.
+    """
+    values = tuple(float(v) for v in quat_xyzw)
+    if len(values) != 4 or not all(map(math.isfinite, values)):
+        return None
+    norm = math.sqrt(sum(v * v for v in values))
+    if not norm > 0.0 or not math.isfinite(norm):
+        return None
+    x, y, z, w = (v / norm for v in values)
+    return x, y, z, w
+
+
+def quaternion_to_matrix(quat_xyzw: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
+    """Rotation matrix (rows) of a quaternion given as (x, y, z, w); normalised first.
+
+    The identity when the quaternion has no direction (see :func:`unit_quaternion`).
+    """
+    unit = unit_quaternion(quat_xyzw)
+    if unit is None:
+        return ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    x, y, z, w = unit
+    return ((1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - z * w), 2.0 * (x * z + y * w)),
+            (2.0 * (x * y + z * w), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - x * w)),
+            (2.0 * (x * z - y * w), 2.0 * (y * z + x * w), 1.0 - 2.0 * (x * x + y * y)))
+
+
+def matrix_to_rpy(rotation: Matrix3) -> tuple[float, float, float]:
+    """URDF roll, pitch, yaw of a rotation matrix: the inverse of :func:`rpy_to_matrix`, pitch in [-pi/2, pi/2].
+
+    Pitch comes from ``atan2(-r20, hypot(r00, r10))`` (well conditioned everywhere, unlike
+    ``asin``), yaw from the first column, and roll from ``Rz(yaw)^T R`` once yaw is known, so that
+    near gimbal lock (pitch at +-pi/2, where roll and yaw are not separately defined) the roll
+    makes up for whatever yaw the rounding gave: the angles rebuild the matrix to ~1e-16 everywhere,
+    lock included (reading roll from ``atan2(r21, r22)`` there loses all its digits).
+    """
+    r = rotation
+    pitch = math.atan2(-r[2][0], math.hypot(r[0][0], r[1][0]))
+    yaw = math.atan2(r[1][0], r[0][0])
+    cy, sy = math.cos(yaw), math.sin(yaw)
+    roll = math.atan2(sy * r[0][2] - cy * r[1][2], cy * r[1][1] - sy * r[0][1])
+    return float(roll), float(pitch), float(yaw)

@@ -13,7 +13,11 @@ pybullet in three measured ways (``docs/pybullet-facts.md``, sections 7 and 10):
   indices follow the file), pybullet crashes in C when the root link is not the first ``<link>``
   element (every UR arm of example-robot-data, TIAGo, Talos, PR2, Romeo) and gives NaN frames to a
   link declared before its parent. The copy lists the links parent first, root first, otherwise in
-  the file's order, so both cannot happen.
+  the file's order, so both cannot happen;
+- URDF 1.1 orientations: pybullet ignores ``<origin quat_xyzw>`` (measured: the frame stays
+  unrotated), so each one becomes the ``rpy`` of the same rotation (full precision), the rotation
+  ar3cli's own FK uses. ``<capsule>`` needs nothing: pybullet reads it as urdfdom does (radius,
+  cylinder ``length`` along z, hemispherical caps; measured with ``getAABB``).
 
 Only the ``<link>`` elements move (into the slots links held before); joints and everything else
 stay where they were. Names and geometry are untouched, so every command's link naming is the
@@ -31,7 +35,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from ar3cli.urdf.model import Model
+from ar3cli.urdf.model import Model, read_quaternion
 
 UNNAMED_ROBOT = "robot"
 """The name given to a ``<robot>`` without one (UR3 and hector's quadrotor in example-robot-data):
@@ -65,6 +69,7 @@ def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None 
     if not root.get("name"):
         root.set("name", UNNAMED_ROBOT)  # pybullet refuses a <robot> without one ("Expected a name for robot")
     _order_links_parent_first(root, ((joint.parent, joint.child) for joint in model.joints))
+    _quaternions_as_rpy(root)
     etree.indent(root, space=" ")
     for element in root.iter():
         uri = element.get("filename")
@@ -77,6 +82,20 @@ def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None 
     if lines is not None:
         lines.update(line_map(model, root, document))
     return document
+
+
+def _quaternions_as_rpy(root: Any) -> None:
+    """Replace every ``<origin quat_xyzw>`` by the ``rpy`` the Model read for it (see :class:`~ar3cli.urdf.model.Origin`):
+    pybullet ignores the quaternion. An origin that also has ``rpy`` keeps it (the Model reads that),
+    and an unusable quaternion leaves no rotation, as the Model does."""
+    for element in root.iter("origin"):
+        text = element.get("quat_xyzw")
+        if text is None:
+            continue
+        del element.attrib["quat_xyzw"]
+        quat = read_quaternion(text)
+        if element.get("rpy") is None and quat is not None:
+            element.set("rpy", " ".join(repr(angle) for angle in quat[1]))
 
 
 def write_loadable_copy(model: Model, path: Path, visuals: bool = True, lines: LineMap | None = None) -> Path:

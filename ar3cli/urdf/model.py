@@ -10,6 +10,7 @@ commands still load the file. Nothing here imports pybullet or trimesh.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
@@ -18,6 +19,7 @@ from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import read_bytes
+from ar3cli.physics.tensor_math import matrix_to_rpy, quaternion_to_matrix, rpy_to_matrix, unit_quaternion
 from ar3cli.urdf import xacro_expand, xmlsource
 from ar3cli.urdf.packages import PackageResolver, Resolution
 from ar3cli.urdf.xmlsource import Quirk
@@ -31,6 +33,13 @@ MOVING_JOINT_TYPES = (*ACTUATED_JOINT_TYPES, "planar", "floating", "spherical")
 """Joint types whose child link moves relative to its parent (``spherical`` is PyBullet's ball joint)."""
 URDF_JOINT_TYPES = (*ACTUATED_JOINT_TYPES, "fixed", "floating", "planar")
 """The joint types of the URDF spec."""
+URDF_VERSION_FEATURES: Mapping[str, tuple[int, int]] = {
+    "quat_xyzw": (1, 1), "capsule": (1, 1), "acceleration": (1, 2), "deceleration": (1, 2), "jerk": (1, 2)}
+"""What URDF 1.1 and 1.2 added and the ``<robot version>`` that declares it: urdfdom 5.1 reads 1.1
+(``<origin quat_xyzw>``, ``<capsule>``), urdfdom 6.0 reads 1.2 (``acceleration``, ``deceleration`` and
+``jerk`` on ``<limit>``). A feature used in a file that declares an older version is ignored by
+urdfdom with a warning (a capsule's whole visual or collision is dropped); urdfdom before 5.1 refuses
+any version but 1.0, and refuses a capsule ("Unknown geometry type")."""
 
 
 @lru_cache(maxsize=4096)
@@ -59,11 +68,21 @@ def parse_float(text: str | None) -> float | None:
 
 @dataclass(frozen=True)
 class Origin:
-    """An ``<origin>``; identity when the element is absent or malformed."""
+    """An ``<origin>``; identity when the element is absent or malformed.
+
+    The orientation is ``rpy`` (URDF 1.0) or ``quat_xyzw`` (URDF 1.1: x, y, z, w, normalised as
+    urdfdom does). With a quaternion, ``quat_xyzw`` holds it and ``rpy`` holds the same rotation as
+    roll-pitch-yaw, so code written for rpy places the frame right; :attr:`rotation` is the exact
+    matrix either way. The quaternion is read whatever version the file declares (urdfdom ignores
+    it below 1.1: the linter says so); when ``rpy`` is also given, ``rpy`` wins (urdfdom ignores the
+    quaternion in a 1.0 file and refuses a 1.1 file that has both). A quaternion that is not four
+    finite numbers, or all zeros, leaves the identity, like a malformed ``rpy``.
+    """
 
     xyz: Vec3 = (0.0, 0.0, 0.0)
     rpy: Vec3 = (0.0, 0.0, 0.0)
     element: Any = None
+    quat_xyzw: tuple[float, float, float, float] | None = None
 
     @classmethod
     def from_parent(cls, parent) -> Origin:
@@ -71,8 +90,28 @@ class Origin:
         if element is None:
             return cls()
         xyz = parse_floats(element.get("xyz", "0 0 0"), 3) or (0.0, 0.0, 0.0)
-        rpy = parse_floats(element.get("rpy", "0 0 0"), 3) or (0.0, 0.0, 0.0)
+        rpy_text, quat_text = element.get("rpy"), element.get("quat_xyzw")
+        if quat_text is not None and rpy_text is None:
+            quat = read_quaternion(quat_text)
+            if quat is not None:
+                return cls(xyz, quat[1], element, quat[0])  # type: ignore[arg-type]
+        rpy = parse_floats(rpy_text or "0 0 0", 3) or (0.0, 0.0, 0.0)
         return cls(xyz, rpy, element)  # type: ignore[arg-type]
+
+    @property
+    def rotation(self) -> tuple[tuple[float, float, float], ...]:
+        """The rotation matrix (rows): from the quaternion when one was given, else from ``rpy``."""
+        return quaternion_to_matrix(self.quat_xyzw) if self.quat_xyzw is not None else rpy_to_matrix(self.rpy)
+
+
+@lru_cache(maxsize=1024)
+def read_quaternion(text: str) -> tuple[tuple[float, float, float, float], Vec3] | None:
+    """The unit quaternion in a ``quat_xyzw`` text and its roll-pitch-yaw, or None when unusable."""
+    values = parse_floats(text, 4)
+    unit = unit_quaternion(values) if values is not None else None
+    if unit is None:
+        return None
+    return unit, matrix_to_rpy(quaternion_to_matrix(unit))
 
 
 @dataclass(frozen=True)
@@ -120,13 +159,20 @@ class Inertial:
 
 @dataclass(frozen=True)
 class Limit:
-    """A joint ``<limit>``; each value None when absent or malformed."""
+    """A joint ``<limit>``; each value None when absent or malformed.
+
+    ``acceleration``, ``deceleration`` and ``jerk`` are URDF 1.2's (urdfdom 6): kept for the rules
+    and reports that will want them; nothing in ar3cli enforces them (PyBullet ignores them).
+    """
 
     lower: float | None
     upper: float | None
     effort: float | None
     velocity: float | None
     element: Any
+    acceleration: float | None = None
+    deceleration: float | None = None
+    jerk: float | None = None
 
 
 @dataclass(frozen=True)
@@ -194,6 +240,21 @@ class Model:
     @property
     def name(self) -> str | None:
         return self.root.get("name")
+
+    @cached_property
+    def urdf_version(self) -> tuple[int, int] | None:
+        """The ``<robot version="MAJOR.MINOR">`` the file declares; (1, 0) when it declares none (urdfdom's
+        default), None when the text is not ``MAJOR.MINOR`` (urdfdom refuses such a file)."""
+        text = self.root.get("version")
+        if text is None:
+            return (1, 0)
+        match = re.fullmatch(r"([0-9]+)\.([0-9]+)", text.strip())
+        return (int(match.group(1)), int(match.group(2))) if match else None
+
+    def declares(self, feature: str) -> bool:
+        """True when the file declares a URDF version that has ``feature`` (a key of :data:`URDF_VERSION_FEATURES`)."""
+        version = self.urdf_version
+        return version is not None and version >= URDF_VERSION_FEATURES[feature]
 
     def link(self, name: str) -> Link | None:
         return self._links_by_name.get(name)
@@ -370,7 +431,8 @@ def _read_joint(element) -> Joint:
     limit = None
     if limit_element is not None:
         limit = Limit(*(parse_float(limit_element.get(key)) for key in ("lower", "upper", "effort", "velocity")),
-                      element=limit_element)
+                      element=limit_element,
+                      **{key: parse_float(limit_element.get(key)) for key in ("acceleration", "deceleration", "jerk")})
     axis_element = element.find("axis")
     axis = parse_floats(axis_element.get("xyz"), 3) if axis_element is not None else None
     mimic_element = element.find("mimic")

@@ -90,7 +90,7 @@ XACRO_SOURCE_HINT = ("This file is a xacro source (it holds <xacro:...> elements
 
 
 NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
-    "origin": {"xyz": 3, "rpy": 3},
+    "origin": {"xyz": 3, "rpy": 3, "quat_xyzw": 4},
     "axis": {"xyz": 3},
     "box": {"size": 3},
     "mesh": {"scale": 0},  # 1 or 3 numbers (one number is G007's business)
@@ -99,7 +99,7 @@ NUMERIC_ATTRIBUTES: dict[str, dict[str, int]] = {
     "sphere": {"radius": 1},
     "mass": {"value": 1},
     "inertia": {key: 1 for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")},
-    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1},
+    "limit": {"lower": 1, "upper": 1, "effort": 1, "velocity": 1, "acceleration": 1, "deceleration": 1, "jerk": 1},
     "dynamics": {"damping": 1, "friction": 1},
     "mimic": {"multiplier": 1, "offset": 1},
     "safety_controller": {"soft_lower_limit": 1, "soft_upper_limit": 1, "k_position": 1, "k_velocity": 1},

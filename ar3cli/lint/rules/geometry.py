@@ -195,8 +195,9 @@ def pybullet_only_path(ctx) -> Iterator[Hit]:
 SPEC_SHAPES = ("box", "cylinder", "sphere", "mesh")
 """The geometry elements of the URDF spec (wiki.ros.org/urdf/XML/link)."""
 READERS = {
-    "capsule": "PyBullet, Drake and MuJoCo read it; urdfdom refuses the whole file (\"Unknown geometry type "
-               "'capsule'\"), and with it robot_state_publisher, RViz, MoveIt and Pinocchio",
+    "capsule": "it is URDF 1.1, which the file does not declare: urdfdom 5.1+ drops this shape with a warning, "
+               "older urdfdom refuses the whole file (\"Unknown geometry type 'capsule'\"), and with it "
+               "robot_state_publisher, RViz, MoveIt and Pinocchio; PyBullet, Drake and MuJoCo read it",
     "plane": "only PyBullet reads it (an infinite plane); urdfdom, Drake and MuJoCo refuse the file",
     "cdf": "only PyBullet reads it; urdfdom, Drake and MuJoCo refuse the file",
     "drake:capsule": "only Drake reads it; urdfdom, PyBullet and MuJoCo refuse the file",
@@ -208,7 +209,10 @@ READERS = {
             "reads it",
 }
 """What reads each geometry outside the spec (G010). Measured with pybullet 3.2.7; the others from their
-parsers: urdfdom link.cpp parseGeometry, Drake detail_urdf_geometry.cc ParseGeometry, MuJoCo xml_urdf.cc Geom."""
+parsers: urdfdom link.cpp parseGeometry, Drake detail_urdf_geometry.cc ParseGeometry, MuJoCo xml_urdf.cc Geom.
+``capsule`` is spec since URDF 1.1 (urdfdom 5.1): G010 names it only where the file does not declare 1.1."""
+CAPSULE_HINT = ('Declare URDF 1.1 (or later), which has <capsule>: <robot name="..." version="1.1">; or use spec '
+                "1.0 shapes (a cylinder plus two spheres) for tools built on urdfdom older than 5.1.")
 
 
 def _shape_elements(ctx):
@@ -219,18 +223,19 @@ def _shape_elements(ctx):
 
 
 @rule("G010", "non-spec-geometry", "warning", "Geometry outside the URDF spec",
-      why="""The URDF spec knows box, cylinder, sphere and mesh. Engines extend it differently:
-      <capsule> is read by PyBullet, Drake and MuJoCo but makes urdfdom (and so every ROS tool and
-      Pinocchio) refuse the whole file; <plane> and <cdf> are PyBullet's alone; .vtk and .cdf mesh
-      files load in PyBullet without a shape. The file then works in one engine and fails, or
-      silently loses a shape, in the next.""",
-      fix="Use a spec shape (a capsule is a cylinder plus two spheres, a plane a thin box), or keep the file for the "
-          "one engine that reads it.",
+      why="""URDF 1.0 knows box, cylinder, sphere and mesh; URDF 1.1 adds <capsule> for files that
+      declare it (<robot version="1.1">, read by urdfdom 5.1 and later). Engines extend it differently:
+      <capsule> is read by PyBullet, Drake and MuJoCo, but in a file that does not declare 1.1 urdfdom
+      5.1+ drops the shape and older urdfdom (and so every ROS tool and Pinocchio) refuses the whole
+      file; <plane> and <cdf> are PyBullet's alone; .vtk and .cdf mesh files load in PyBullet without
+      a shape. The file then works in one engine and fails, or silently loses a shape, in the next.""",
+      fix="Declare <robot version=\"1.1\"> for a capsule; otherwise use a spec shape (a capsule is a cylinder plus "
+          "two spheres, a plane a thin box), or keep the file for the one engine that reads it.",
       bad=robot(f'''<link name="base">{LINK_INERTIAL}<collision><geometry><capsule radius="0.05" length="0.3"/></geometry></collision></link>'''),
-      good=robot(f'''<link name="base">{LINK_INERTIAL}<collision><geometry><cylinder radius="0.05" length="0.3"/></geometry></collision>
-          <collision><origin xyz="0 0 0.15"/><geometry><sphere radius="0.05"/></geometry></collision>
-          <collision><origin xyz="0 0 -0.15"/><geometry><sphere radius="0.05"/></geometry></collision></link>'''),
-      references="urdfdom urdf_parser/src/link.cpp parseGeometry; Drake multibody/parsing/detail_urdf_geometry.cc; "
+      good=robot(f'''<link name="base">{LINK_INERTIAL}<collision><geometry><capsule radius="0.05" length="0.3"/></geometry></collision></link>'''
+                 ).replace('<robot name="r">', '<robot name="r" version="1.1">'),
+      references="urdfdom urdf_parser/src/link.cpp parseGeometry and README (URDF versioning; capsule and quat_xyzw "
+                 "in 1.1 since urdfdom 5.1.0, ros/urdfdom#238); Drake multibody/parsing/detail_urdf_geometry.cc; "
                  "MuJoCo src/xml/xml_urdf.cc; PyBullet UrdfParser.cpp (measured with pybullet 3.2.7).")
 def non_spec_geometry(ctx) -> Iterator[Hit]:
     from lxml import etree
@@ -246,6 +251,10 @@ def non_spec_geometry(ctx) -> Iterator[Hit]:
             if suffix in NON_SPEC_MESH_FORMATS:
                 yield Hit(f"link '{link.name}' {shape.role} mesh {geometry.filename}: {READERS[suffix]}",
                           geometry.element)
+        elif tag == "capsule":
+            if not ctx.model.declares("capsule"):
+                yield Hit(f"link '{link.name}' {shape.role} geometry <capsule>: {READERS['capsule']}", geometry.element,
+                          hint=CAPSULE_HINT)
         elif tag not in SPEC_SHAPES:
             readers = READERS.get(tag, "no engine ar3cli knows reads it; urdfdom, PyBullet, Drake and MuJoCo refuse "
                                        "the file")
