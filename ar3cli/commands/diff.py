@@ -104,7 +104,9 @@ def _pairs(sides: list[str], changed_since: str | None, package_path, xacro_arg)
     except ValueError as exc:
         raise UserError(str(exc)) from None
     selection = select_changed([Path(side) for side in sides or ["."]], changed_since, packages, arguments)
-    return [(_at_ref(changed_since, path), display_path(path)) for path in selection.files]
+    parts = {used for users in selection.dependents.values() for used in users}  # compared through their users
+    return [(_at_ref(changed_since, path), display_path(path)) for path in selection.files
+            if display_path(path) not in parts]
 
 
 def _at_ref(ref: str, path) -> str | None:
