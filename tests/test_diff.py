@@ -383,3 +383,17 @@ def test_no_temporary_folder_is_left_when_git_is_missing(tmp_path):
     result = run_cli("diff", "HEAD:a.urdf", "b.urdf", cwd=tmp_path, env=env)
     assert result.code == 2 and "needs git" in result.stderr
     assert os.listdir(tmp_path / "tmpdir") == []
+
+
+def test_nan_never_reaches_the_output_and_a_floating_joint_is_a_note(tmp_path):
+    old = write(tmp_path, "old.urdf", ARM)
+    nan = write(tmp_path, "nan.urdf", ARM.replace('xyz="0 0 0.3"', 'xyz="nan 0 0.3"').replace(
+        '<mass value="0.5"/>', '<mass value="nan"/>'))
+    text = run_cli("diff", str(old), str(nan), "-n", "3")
+    assert text.code == 1 and "| nan " not in text.stdout.replace("nan.urdf", "")
+    document = diff_json(str(old), str(nan), code=1)  # json.loads refuses nothing: NaN would be written as NaN
+    assert "NaN" not in json.dumps(document)
+    assert document["robots"][0]["kinematics"][0]["home_m"] is None
+    floating = write(tmp_path, "floating.urdf", ARM.replace('name="shoulder" type="revolute"', 'name="shoulder" type="floating"'))
+    robot = diff_json(str(old), str(floating), code=1)["robots"][0]
+    assert robot["notes"] and "kinematics not compared" in robot["notes"][0]

@@ -45,9 +45,10 @@ def shape_changes(pair: Pair, link: str, index: int, old: Shape, new: Shape) -> 
     moved = origin_changed(old.origin, new.origin, tolerance)
     if moved is not None:
         metres, radians = moved
+        translated = not metres <= tolerance.length
         add("origin", f"xyz {_text(old.origin.xyz)} rpy {_text(old.origin.rpy)}",
-            f"xyz {_text(new.origin.xyz)} rpy {_text(new.origin.rpy)}", metres if metres > tolerance.length else radians,
-            "m" if metres > tolerance.length else "rad", where=new.element)
+            f"xyz {_text(new.origin.xyz)} rpy {_text(new.origin.rpy)}", metres if translated else radians,
+            "m" if translated else "rad", where=new.element)
     if not changes and new.geometry.kind == "mesh":
         changes += _bounds_change(pair, name, old, new, at)
     return changes

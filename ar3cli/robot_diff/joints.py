@@ -34,8 +34,9 @@ def joint_deltas(old: Joint, new: Joint, tolerance: Tolerance, link_map: dict[st
     moved = origin_changed(old.origin, new.origin, tolerance)
     if moved is not None:
         metres, radians = moved
-        deltas.append(JointDelta("origin", _origin_text(old), _origin_text(new), metres if metres > tolerance.length
-                                 else radians, "m" if metres > tolerance.length else "rad"))
+        translated = not metres <= tolerance.length  # NaN counts as translated
+        deltas.append(JointDelta("origin", _origin_text(old), _origin_text(new), metres if translated else radians,
+                                 "m" if translated else "rad"))
     if new.type in AXIS_MATTERS or old.type in AXIS_MATTERS:
         angle = vector_angle(old.axis, new.axis)
         if not angle <= tolerance.angle:  # NaN (a zero axis) counts

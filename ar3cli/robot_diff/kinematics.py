@@ -19,7 +19,7 @@ from ar3cli.errors import UserError
 from ar3cli.robot_diff.joints import joint_deltas
 from ar3cli.robot_diff.limits import mimic_deltas
 from ar3cli.robot_diff.pair import Pair
-from ar3cli.robot_diff.records import Displacement
+from ar3cli.robot_diff.records import Displacement, finite_or_none
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 
@@ -97,9 +97,9 @@ def displacements(pair: Pair, fk: ForwardKinematics, samples: int, seed: int
         sampled_m, sampled_rad = (metres[1:], radians[1:]) if samples else (metres, radians)
         if not (float(np.max(metres)) <= tolerance.length and float(np.max(radians)) <= tolerance.angle):
             file, line = pair.new_locator.locate(pair.new.link(link).element)  # type: ignore[union-attr]
-            moved.append(Displacement(link, float(metres[0]), float(radians[0]), float(np.max(sampled_m)),
-                                      float(np.mean(sampled_m)), float(np.max(sampled_rad)), float(np.mean(sampled_rad)),
-                                      cause(pair, link), file, line))
+            measures = [float(value) for value in (metres[0], radians[0], np.max(sampled_m), np.mean(sampled_m),
+                                                   np.max(sampled_rad), np.mean(sampled_rad))]
+            moved.append(Displacement(link, *map(finite_or_none, measures), cause(pair, link), file, line))  # type: ignore[arg-type]
     homes = ({name: frames[0] for name, frames in old_frames.items()},
              {name: frames[0] for name, frames in new_frames.items()})
     return moved, homes, []

@@ -68,12 +68,13 @@ class Displacement:
     """How far an end effector (a leaf link) of NEW is from where OLD puts it, over the same joint values."""
 
     link: str
-    home_m: float
-    home_rad: float
-    max_m: float
-    mean_m: float
-    max_rad: float
-    mean_rad: float
+    home_m: float | None
+    home_rad: float | None
+    max_m: float | None
+    mean_m: float | None
+    max_rad: float | None
+    mean_rad: float | None
+    """Metres and radians; None where a value of the file is not a number (NaN never reaches the output)."""
     cause: str
     """The first joint on the path from the root whose origin, axis or type changed, and what; or ``-``."""
     file: str = ""

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from typing import Any
 
 from ar3cli.output.report import Report, Table
-from ar3cli.robot_diff.records import RobotDiff, show
+from ar3cli.robot_diff.records import RobotDiff, finite_or_none, show
 from ar3cli.robot_diff.tolerance import Tolerance
 
 CHANGE_COLUMNS = ["section", "element", "change", "old", "new", "amount", "at"]
@@ -23,7 +23,8 @@ def verdict(diffs: Sequence[RobotDiff]) -> str:
 
 
 def _amount(amount: float | None, unit: str) -> str:
-    return "" if amount is None else f"{show(round(amount, 12) if amount == amount else amount)} {unit}".strip()
+    amount = finite_or_none(amount)
+    return "" if amount is None else f"{show(round(amount, 12))} {unit}".strip()
 
 
 def _kinematic_row(moved) -> list[Any]:
@@ -109,7 +110,7 @@ def annotations(diffs: Sequence[RobotDiff]) -> str:
     for diff in diffs:
         out += [line("warning", c.file, c.line, f"ar3cli diff: {c.section}", c.summary) for c in diff.changes]
         out += [line("warning", m.file, m.line, "ar3cli diff: kinematics",
-                     f"link '{m.link}' moved {m.home_m:.4g} m, {m.home_rad:.4g} rad at home (max {m.max_m:.4g} m, "
-                     f"{m.max_rad:.4g} rad over the samples); cause: {m.cause}") for m in diff.displacements]
+                     f"link '{m.link}' moved {show(m.home_m)} m, {show(m.home_rad)} rad at home (max {show(m.max_m)} m, "
+                     f"{show(m.max_rad)} rad over the samples); cause: {m.cause}") for m in diff.displacements]
         out += [line("notice", f.file, f.line, f"ar3cli diff: lint {f.rule} {f.status}", f.message) for f in diff.findings]
     return "".join(text + "\n" for text in out)
