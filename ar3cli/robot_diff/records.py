@@ -17,11 +17,12 @@ def finite_or_none(value: float | None) -> float | None:
 
 
 def show(value: Any) -> str:
-    """A value for a table cell: numbers with up to 9 significant digits, tuples space-separated, None as ``-``."""
+    """A value for a table cell: numbers with up to 9 significant digits (NaN and inf as ``(not a number)``),
+    tuples space-separated, None as ``-``."""
     if value is None:
         return "-"
     if isinstance(value, float):
-        return f"{value:.9g}"
+        return f"{value:.9g}" if math.isfinite(value) else "(not a number)"
     if isinstance(value, (tuple, list)):
         return " ".join(show(item) for item in value)
     return str(value)
