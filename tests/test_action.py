@@ -329,3 +329,25 @@ def test_documented_workflow_runs(robots, tmp_path):
         assert not run.failed, f"{step}\n{run.stdout[-2000:]}\n{run.stderr[-2000:]}"
         assert run.outputs["exit-code"] == "0"
         assert "## ar3cli lint-urdf" in run.summary
+
+
+def test_diff_input_posts_the_markdown_diff_of_the_changed_robots(tmp_path):
+    import subprocess
+
+    from tests.test_diff import ARM
+
+    workspace = tmp_path / "workspace"
+    (workspace / "robots").mkdir(parents=True)
+    (workspace / "robots" / "arm.urdf").write_text(ARM, encoding="utf-8")
+    (workspace / "robots" / "same.urdf").write_text(ARM, encoding="utf-8")
+    git = ["git", "-c", "user.name=t", "-c", "user.email=t@example.com", "-c", "commit.gpgsign=false", "-C", str(workspace)]
+    for args in (["init", "-q"], ["add", "-A"], ["commit", "-qm", "arm"]):
+        subprocess.run([*git, *args], check=True, capture_output=True)
+    (workspace / "robots" / "arm.urdf").write_text(ARM.replace('xyz="0 0 0.3"', 'xyz="0 0 0.34"'), encoding="utf-8")
+    run = run_action(workspace, tmp_path, paths="robots", diff="true", **{"diff-base": "HEAD"})
+    assert run.steps["diff"]["outcome"] == "success", run.stderr  # changes are reported, not a failure
+    assert "## ar3cli diff" in run.summary and "## ar3cli lint-urdf" in run.summary
+    assert "robots/arm.urdf" in run.summary and "same.urdf" not in run.summary.split("## ar3cli diff")[1]
+    assert "| kinematics | joint 'elbow' | origin |" in run.summary
+    (tmp_path / "off").mkdir()
+    assert run_action(workspace, tmp_path / "off", paths="robots").steps["diff"]["outcome"] == "skipped"

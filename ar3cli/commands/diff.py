@@ -1,0 +1,164 @@
+"""``ar3cli diff OLD NEW``: what a change to a robot description does to the robot, compared
+semantically (structure, end-effector kinematics, dynamics, limits, geometry, lint findings).
+
+The work is in :mod:`ar3cli.robot_diff`; this module reads the sides (paths, ``REV:path``, or every
+robot file ``--changed-since`` selects), lints both models and hands the findings and ar3cli's own
+forward kinematics to the diff (feature packages do not import each other).
+"""
+
+from __future__ import annotations
+
+import enum
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.commands.options import PackagePathOption, SeedOption, XacroArgOption, samples_option
+from ar3cli.errors import UserError
+from ar3cli.output.report import finish
+
+
+class DiffFormat(str, enum.Enum):
+    text = "text"
+    json = "json"
+    markdown = "markdown"
+    github = "github"
+
+
+SidesArgument = Annotated[Optional[list[str]], typer.Argument(
+    metavar="OLD NEW", show_default=False,
+    help="Two robot files, each a path or REV:path (the file as git revision REV holds it, read without a "
+         "checkout). With --changed-since: the files or folders to search (default: the current folder).")]
+ChangedSinceOption = Annotated[Optional[str], typer.Option(
+    "--changed-since", metavar="REF", show_default=False,
+    help="Compare every robot file that changed since the git ref REF (or uses a changed file, as lint-urdf "
+         "--changed-since selects them) with its version at REF.")]
+SamplesOption = Annotated[int, samples_option("Random configurations of the shared joints, on top of the home pose.",
+                                              most=100_000)]
+ToleranceOption = Annotated[float, typer.Option(
+    "--tolerance", help="What counts as a change: metres for lengths, radians for angles, and a fraction of the "
+                        "larger value for masses, inertias, efforts and velocities.")]
+ToleranceMOption = Annotated[Optional[float], typer.Option("--tolerance-m", show_default=False,
+                                                           help="Length tolerance (m); default: --tolerance.")]
+ToleranceRadOption = Annotated[Optional[float], typer.Option("--tolerance-rad", show_default=False,
+                                                             help="Angle tolerance (rad); default: --tolerance.")]
+FormatOption = Annotated[DiffFormat, typer.Option(
+    "--format", "-f", help="text (tables), json (one document on stdout), markdown (for a pull-request comment) "
+                           "or github (workflow annotations; the Markdown is appended to $GITHUB_STEP_SUMMARY).")]
+
+
+def diff(
+    sides: SidesArgument = None,
+    changed_since: ChangedSinceOption = None,
+    samples: SamplesOption = 100,
+    seed: SeedOption = 0,
+    tolerance: ToleranceOption = 1e-9,
+    tolerance_m: ToleranceMOption = None,
+    tolerance_rad: ToleranceRadOption = None,
+    package_path: PackagePathOption = None,
+    xacro_arg: XacroArgOption = None,
+    format: FormatOption = DiffFormat.text,
+) -> None:
+    """Show what NEW changes about OLD's robot: links and joints added, removed or renamed, how far
+    every end effector moved (home pose and random configurations) and which joint moved it, masses
+    and inertias, limits, geometry, and the lint findings that came or went.
+
+    Semantic, not textual: comments, attribute order, whitespace, number spelling and equal
+    rotations written differently are no change. Exit 0 no change, 1 changes beyond the tolerance,
+    2 usage errors.
+    """
+    from ar3cli.robot_diff.tolerance import Tolerance
+
+    values = [tolerance, tolerance_m, tolerance_rad]
+    if not all(value is None or value >= 0 for value in values):
+        raise UserError("--tolerance, --tolerance-m and --tolerance-rad must be zero or positive numbers")
+    limits = Tolerance(tolerance if tolerance_m is None else tolerance_m,
+                       tolerance if tolerance_rad is None else tolerance_rad, tolerance)
+    pairs = _pairs(sides or [], changed_since, package_path, xacro_arg)
+    diffs, errors = [], []
+    for old_spec, new_spec in pairs:
+        try:
+            diffs.append(_compare(old_spec, new_spec, limits, samples, seed, package_path, xacro_arg))
+        except UserError as exc:
+            if len(pairs) == 1:
+                raise
+            errors.append(exc.message)
+    _finish(diffs, errors, limits, samples, seed, format)
+
+
+def _pairs(sides: list[str], changed_since: str | None, package_path, xacro_arg) -> list[tuple[str | None, str]]:
+    """(OLD spec or None for a file REF does not have, NEW spec) of every robot to compare."""
+    if changed_since is None:
+        if len(sides) != 2:
+            raise UserError(f"diff takes two robot files, OLD and NEW (got {len(sides)}); or --changed-since REF")
+        return [(sides[0], sides[1])]
+    from pathlib import Path
+
+    from ar3cli.lint.changed import select_changed
+    from ar3cli.lint.engine import display_path
+    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.urdf.xacro_expand import parse_xacro_args
+
+    try:
+        packages, arguments = parse_package_paths(package_path), parse_xacro_args(xacro_arg)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    selection = select_changed([Path(side) for side in sides or ["."]], changed_since, packages, arguments)
+    parts = {used for users in selection.dependents.values() for used in users}  # compared through their users
+    return [(_at_ref(changed_since, path), display_path(path)) for path in selection.files
+            if display_path(path) not in parts]
+
+
+def _at_ref(ref: str, path) -> str | None:
+    """``REF:path`` when REF holds the file, else None (the file was added since)."""
+    from ar3cli.robot_diff.git_source import exists_at, repository_path, resolve_commit
+
+    root, inside = repository_path(str(path))
+    return f"{ref}:{path}" if exists_at(root, resolve_commit(root, ref), inside) else None
+
+
+def _compare(old_spec: str | None, new_spec: str, limits, samples: int, seed: int, package_path, xacro_arg):
+    """Load both sides (a revision from its temporary copy), lint them and diff them."""
+    from ar3cli.kinematics import fk
+    from ar3cli.robot_diff.compare import compare_models
+    from ar3cli.robot_diff.git_source import open_side
+    from ar3cli.robot_diff.records import Change, RobotDiff
+    from ar3cli.urdf.loading import load_with_specs
+
+    if old_spec is None:
+        return RobotDiff("(none)", new_spec, [Change("structure", "robot file", "added", new=new_spec, file=new_spec)])
+    with open_side(old_spec) as old_side, open_side(new_spec) as new_side:
+        models = []
+        for side in (old_side, new_side):
+            try:
+                models.append(load_with_specs(side.path, package_path, xacro_arg))
+            except UserError as exc:
+                raise UserError(side.relabel(exc.message)) from None
+        findings = tuple(_lint(model, side.label) for model, side in zip(models, (old_side, new_side)))
+        return compare_models(models[0], models[1], old_side.label, new_side.label, fk=fk, tolerance=limits,
+                              samples=samples, seed=seed, findings=findings,  # type: ignore[arg-type]
+                              show_old=old_side.show, show_new=new_side.show)
+
+
+def _lint(model, shown: str) -> list:
+    """The static lint findings of a loaded model (every rule, default severities)."""
+    from ar3cli.lint.engine import LintOptions, lint_model
+
+    options = LintOptions()
+    return lint_model(model, shown, options.rules(), options).findings
+
+
+def _finish(diffs, errors: list[str], limits, samples: int, seed: int, fmt: DiffFormat) -> None:
+    from ar3cli.robot_diff.render import annotations, markdown, report
+
+    result = report(diffs, limits, samples, seed, errors)
+    if fmt in (DiffFormat.markdown, DiffFormat.github):
+        text = markdown(diffs, samples, seed)
+        if fmt is DiffFormat.github:
+            from ar3cli.output.github import append_step_summary
+
+            failed = append_step_summary(text)
+            result.errors += [failed] if failed else []
+            text = annotations(diffs)
+        result.text, result.tables, result.lines = text, [], []
+    finish(result, "json" if fmt is DiffFormat.json else "text")

@@ -1,0 +1,116 @@
+"""The diff as the output layer shows it: tables and JSON (:class:`~ar3cli.output.report.Report`),
+Markdown for a pull-request comment or the step summary, and GitHub workflow annotations."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Any
+
+from ar3cli.output.report import Report, Table
+from ar3cli.robot_diff.records import RobotDiff, finite_or_none, show
+from ar3cli.robot_diff.tolerance import Tolerance
+
+CHANGE_COLUMNS = ["section", "element", "change", "old", "new", "amount", "at"]
+KINEMATIC_COLUMNS = ["end effector", "home m", "home rad", "max m", "mean m", "max rad", "mean rad", "cause"]
+
+
+def verdict(diffs: Sequence[RobotDiff]) -> str:
+    changed = [diff for diff in diffs if diff.changed]
+    if not changed:
+        return f"no semantic change ({len(diffs)} robot file{'s' if len(diffs) != 1 else ''} compared)"
+    count = sum(len(diff.changes) + len(diff.displacements) for diff in changed)
+    return f"CHANGED: {count} change(s) in {len(changed)} of {len(diffs)} robot file(s)"
+
+
+def _amount(amount: float | None, unit: str) -> str:
+    amount = finite_or_none(amount)
+    return "" if amount is None else f"{show(round(amount, 12))} {unit}".strip()
+
+
+def _kinematic_row(moved) -> list[Any]:
+    return [moved.link, moved.home_m, moved.home_rad, moved.max_m, moved.mean_m, moved.max_rad, moved.mean_rad,
+            moved.cause]
+
+
+def report(diffs: Sequence[RobotDiff], tolerance: Tolerance, samples: int, seed: int,
+           errors: Sequence[str] = ()) -> Report:
+    """Tables per robot (changes, end-effector displacement, findings) and the JSON document."""
+    data = {"changed": any(diff.changed for diff in diffs), "tolerance": tolerance.to_dict(), "samples": samples,
+            "seed": seed, "robots": [diff.to_dict() for diff in diffs], "errors": list(errors)}
+    tables: list[Table] = []
+    lines: list[str] = []
+    for diff in diffs:
+        title = f"{diff.old} -> {diff.new}"
+        if diff.changes:
+            tables.append(Table(f"{title}: changes", CHANGE_COLUMNS,
+                                [[c.section, c.element, c.what, c.old, c.new, _amount(c.amount, c.unit),
+                                  f"{c.file}:{c.line}" if c.line else c.file] for c in diff.changes],
+                                nowrap_columns=("at",)))
+        if diff.displacements:
+            tables.append(Table(f"{title}: end effectors moved (home pose and {samples} samples, seed {seed})",
+                                KINEMATIC_COLUMNS, [_kinematic_row(moved) for moved in diff.displacements],
+                                numeric_columns=tuple(KINEMATIC_COLUMNS[1:7])))
+        if diff.findings:
+            tables.append(Table(f"{title}: lint findings", ["status", "rule", "severity", "message", "at"],
+                                [[f.status, f.rule, f.severity, f.message, f"{f.file}:{f.line}" if f.line else f.file]
+                                 for f in diff.findings], status_column="severity"))
+        lines += [f"{title}: {note}" for note in diff.notes]
+        if not diff.changed:
+            lines.append(f"{title}: no semantic change")
+    lines.append(verdict(diffs) + f" (tolerance {tolerance.length:g} m, {tolerance.angle:g} rad, "
+                                  f"{tolerance.relative:g} relative; seed {seed})")
+    return Report(data, tables, lines, ok=not data["changed"], errors=list(errors))
+
+
+def _cell(value: Any) -> str:
+    from ar3cli.output.github import markdown_cell
+
+    return markdown_cell(value if isinstance(value, str) else show(value))
+
+
+def markdown(diffs: Sequence[RobotDiff], samples: int, seed: int) -> str:
+    """GitHub-flavoured Markdown: a heading per robot, its changes, moved end effectors and findings."""
+    out = ["## ar3cli diff", "", verdict(diffs), ""]
+    for diff in diffs:
+        out += [f"### `{_cell(diff.old)}` → `{_cell(diff.new)}`", ""]
+        if not diff.changed:
+            out += ["No semantic change.", ""]
+        if diff.changes:
+            out += ["| " + " | ".join(CHANGE_COLUMNS) + " |", "|" + " --- |" * len(CHANGE_COLUMNS)]
+            out += ["| " + " | ".join(_cell(v) for v in (c.section, c.element, c.what, c.old, c.new,
+                                                         _amount(c.amount, c.unit), f"{c.file}:{c.line}" if c.line
+                                                         else c.file)) + " |" for c in diff.changes]
+            out.append("")
+        if diff.displacements:
+            out += [f"End effectors moved (home pose and {samples} samples, seed {seed}):", "",
+                    "| " + " | ".join(KINEMATIC_COLUMNS) + " |", "|" + " --- |" * len(KINEMATIC_COLUMNS)]
+            out += ["| " + " | ".join(_cell(v) for v in _kinematic_row(moved)) + " |" for moved in diff.displacements]
+            out.append("")
+        if diff.findings:
+            out += ["| lint | rule | severity | message |", "| --- | --- | --- | --- |"]
+            out += [f"| {f.status} | {f.rule} | {f.severity} | {_cell(f.message)} |" for f in diff.findings]
+            out.append("")
+        out += [f"_{_cell(note)}_" for note in diff.notes]
+    return "\n".join(out).rstrip("\n") + "\n"
+
+
+def annotations(diffs: Sequence[RobotDiff]) -> str:
+    """``::warning file=F,line=L,title=ar3cli diff::...`` per change and moved end effector, ``::notice``
+    per lint finding that came or went. Changes located only in a revision (``REV:path``) get no file."""
+    from ar3cli.output.github import escape_data, escape_property
+
+    def line(kind: str, file: str, number: int, title: str, message: str) -> str:
+        properties = [f"file={escape_property(file)}"] if file and ":" not in file else []
+        if properties and number:
+            properties.append(f"line={number}")
+        properties.append(f"title={escape_property(title)}")
+        return f"::{kind} {','.join(properties)}::{escape_data(message)}"
+
+    out = []
+    for diff in diffs:
+        out += [line("warning", c.file, c.line, f"ar3cli diff: {c.section}", c.summary) for c in diff.changes]
+        out += [line("warning", m.file, m.line, "ar3cli diff: kinematics",
+                     f"link '{m.link}' moved {show(m.home_m)} m, {show(m.home_rad)} rad at home (max {show(m.max_m)} m, "
+                     f"{show(m.max_rad)} rad over the samples); cause: {m.cause}") for m in diff.displacements]
+        out += [line("notice", f.file, f.line, f"ar3cli diff: lint {f.rule} {f.status}", f.message) for f in diff.findings]
+    return "".join(text + "\n" for text in out)
