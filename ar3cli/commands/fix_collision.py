@@ -4,7 +4,16 @@ from typing import Annotated
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    TimeoutOption,
+)
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -30,6 +39,7 @@ def fix_collision(
     output: OutputOption = None,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Replace a collision mesh that collides as a much larger convex hull by convex parts.
 

@@ -5,7 +5,16 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    TimeoutOption,
+)
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -26,6 +35,7 @@ def fix_joints(
     output: OutputOption = None,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
 

@@ -4,7 +4,16 @@ from typing import Annotated
 
 import typer
 
-from ar3cli.commands.options import CheckOption, DiffOption, FixPathsArgument, FormatOption, OutputOption, PackagePathOption
+from ar3cli.commands.options import (
+    CheckOption,
+    DiffOption,
+    FixPathsArgument,
+    FormatOption,
+    OutputOption,
+    PackagePathOption,
+    TimeoutOption,
+)
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -22,6 +31,7 @@ def fix_mesh_paths(
     output: OutputOption = None,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Rewrite machine-bound mesh and texture URIs to `package://NAME/...`, byte for byte, atomically.
 

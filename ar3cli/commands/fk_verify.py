@@ -10,10 +10,12 @@ from ar3cli.commands.options import (
     PackagePathOption,
     RobotPathArgument,
     SeedOption,
+    TimeoutOption,
     XacroArgOption,
     samples_option,
 )
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat, finish
 from ar3cli.urdf.loading import load_with_specs
 
@@ -35,6 +37,7 @@ def fk_verify(
     format: FormatOption = OutputFormat.text,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Check that PyBullet (and your DH table) put every link frame where the URDF says.
 

@@ -6,8 +6,9 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import PackagePathOption, XacroArgOption
+from ar3cli.commands.options import PackagePathOption, TimeoutOption, XacroArgOption
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import Report, Table, finish
 
 
@@ -90,6 +91,7 @@ def lint_urdf(
         "--srdf", metavar="FILE.srdf", dir_okay=False,
         help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
     = None,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Check URDF and xacro files for mistakes that break ROS tools or make PyBullet misbehave.
 
@@ -272,7 +274,7 @@ def summary_line(summary: dict, cached: int = 0) -> str:
     broken = summary["files_with_errors"]
     clean = summary["files_clean"]
     verdict = "FAILED" if summary["failed"] or broken else "passed"
-    unchecked = f"; {broken} not fully checked (pybullet crashed)" if broken else ""
+    unchecked = f"; {broken} not fully checked (pybullet crashed or timed out)" if broken else ""
     remembered = f"; {cached} unchanged since an earlier run (from the cache)" if cached else ""
     held = ""
     if summary.get("baselined") is not None:

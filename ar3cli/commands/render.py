@@ -5,7 +5,8 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, XacroArgOption
+from ar3cli.commands.options import FormatOption, PackagePathOption, RobotPathArgument, TimeoutOption, XacroArgOption
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat, Report, Table, finish
 from ar3cli.urdf.loading import load_with_specs
 
@@ -26,6 +27,7 @@ def render_command(
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.
 
