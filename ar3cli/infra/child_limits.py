@@ -39,8 +39,10 @@ MEMORY_VARIABLE = "AR3CLI_CHILD_MEMORY_MB"
 
 _timeout: float | None = DEFAULT_TIMEOUT_S
 _PR_SET_PDEATHSIG = 1
-_prepared: tuple[object, int | None] | None = None
-"""(libc's prctl or None, the memory limit): what :func:`prepare` found."""
+_prctl: object = None
+"""libc's prctl, once :func:`prepare` looked it up (False: not available)."""
+_limit: int | None = None
+"""The memory limit :func:`prepare` read last."""
 
 
 def set_timeout(seconds: float | None) -> None:
@@ -83,29 +85,30 @@ def describe_memory_limit() -> str:
 
 
 def prepare() -> None:
-    """In the parent, before forking: look up what every child needs once (prctl, the memory limit)."""
-    global _prepared
-    if _prepared is None:
-        prctl = None
+    """In the parent, before forking: look up what the children need (prctl once, the memory limit)."""
+    global _prctl, _limit
+    if _prctl is None:
+        _prctl = False
         try:
             import ctypes
 
-            prctl = ctypes.CDLL(None, use_errno=True).prctl
+            _prctl = ctypes.CDLL(None, use_errno=True).prctl
         except (OSError, AttributeError):  # pragma: no cover - not Linux, or no libc symbol
             pass
-        _prepared = (prctl, memory_limit())
+    _limit = memory_limit()
 
 
 def enter_child(parent: int) -> None:
-    """In a just-forked child: die with ``parent`` (SIGKILL when it ends; ending now if it is
-    already gone: it may have died before the request was made), and cap the address space
-    (:func:`memory_limit`)."""
-    prepare()
-    prctl, limit = _prepared  # type: ignore[misc]
-    if prctl is not None:
-        prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)
+    """In a just-forked child (after :func:`prepare` in the parent): die with ``parent`` (SIGKILL
+    when it ends; ending now if it is already gone: it may have died before the request was made),
+    and cap the address space (:func:`memory_limit`)."""
+    if _prctl is None:
+        prepare()
+    if _prctl:
+        _prctl(_PR_SET_PDEATHSIG, int(signal.SIGKILL), 0, 0, 0)  # type: ignore[operator]
     if os.getppid() != parent:
         os._exit(1)
+    limit = _limit
     if limit is not None:
         import resource
 
