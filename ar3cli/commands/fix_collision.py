@@ -13,7 +13,7 @@ from ar3cli.commands.options import (
     PackagePathOption,
     TimeoutOption,
 )
-from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
+from ar3cli.infra.child_limits import LONG_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -39,7 +39,7 @@ def fix_collision(
     output: OutputOption = None,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
-    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
+    timeout: TimeoutOption = LONG_TIMEOUT_S,
 ) -> None:
     """Replace a collision mesh that collides as a much larger convex hull by convex parts.
 

@@ -57,4 +57,4 @@ TimeoutOption = Annotated[float, typer.Option(
          "takes longer is stopped, and the file gets a one-line error. 0: no limit. Each such process may also "
          "map at most half of the memory (1-4 GB; AR3CLI_CHILD_MEMORY_MB sets it).")]
 """``--timeout``: commands give the default (:data:`~ar3cli.infra.child_limits.DEFAULT_TIMEOUT_S`, or
-:data:`~ar3cli.infra.child_limits.SAMPLING_TIMEOUT_S` for sample-collisions)."""
+:data:`~ar3cli.infra.child_limits.LONG_TIMEOUT_S` for sample-collisions and fix-collision)."""

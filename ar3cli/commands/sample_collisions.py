@@ -15,7 +15,7 @@ from ar3cli.commands.options import (
     samples_option,
 )
 from ar3cli.errors import UserError
-from ar3cli.infra.child_limits import SAMPLING_TIMEOUT_S
+from ar3cli.infra.child_limits import LONG_TIMEOUT_S
 from ar3cli.output.report import OutputFormat, finish
 from ar3cli.urdf.loading import load_with_specs
 
@@ -65,7 +65,7 @@ def sample_collisions(
     format: FormatOption = OutputFormat.text,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
-    timeout: TimeoutOption = SAMPLING_TIMEOUT_S,
+    timeout: TimeoutOption = LONG_TIMEOUT_S,
 ) -> None:
     """Sample joint configurations and classify every link pair as MoveIt Setup Assistant does.
 

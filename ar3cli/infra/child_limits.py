@@ -29,9 +29,11 @@ DEFAULT_TIMEOUT_S = 120.0
 """Per file, for every command but sample-collisions. A ``lint-urdf --sim`` of Romeo or Talos (the
 largest robots of example-robot-data) takes 1-3 s, so this leaves a slow, loaded CI machine a
 margin of 40x or more, and a hung child still ends in two minutes."""
-SAMPLING_TIMEOUT_S = 900.0
-"""Per file for sample-collisions: its 10,000 default samples of Romeo take ~8 s on one core;
-300,000 samples about four minutes. More samples on a large robot need a larger ``--timeout``."""
+LONG_TIMEOUT_S = 900.0
+"""Per file (per mesh for fix-collision) for the commands whose work grows with a number the user
+gives. sample-collisions: its 10,000 default samples of Romeo take ~8 s on one core, 100,000 about
+80 s. fix-collision: V-HACD on Talos's largest mesh (torso_2.STL, 24,072 faces) takes 1.7 s at the
+default 100,000 voxels, 43 s at 1,000,000, over 120 s at 4,000,000. More needs a larger ``--timeout``."""
 MIN_MEMORY_BYTES = 1 << 30
 MAX_MEMORY_BYTES = 4 << 30
 MEMORY_VARIABLE = "AR3CLI_CHILD_MEMORY_MB"
