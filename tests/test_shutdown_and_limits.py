@@ -212,3 +212,17 @@ def test_timeout_option(cli, tmp_path) -> None:
     result = cli("fk-verify", str(robot), "--timeout", "-1")
     assert result.code == 2 and len(result.stderr.strip().splitlines()) == 1
     assert cli("fk-verify", str(robot), "--timeout", "0", "--samples", "3").code == 0
+
+
+def test_a_c_abort_under_the_memory_limit_names_both_likely_causes(monkeypatch) -> None:
+    """C++ code that cannot allocate aborts (SIGABRT): the report names the memory limit too."""
+    from ar3cli.infra.isolation import CrashError
+
+    monkeypatch.setenv(child_limits.MEMORY_VARIABLE, "2048")
+    with pytest.raises(CrashError) as raised:
+        run_isolated(os.abort, "robot.urdf")
+    assert raised.value.message.startswith("robot.urdf: pybullet crashed (SIGABRT) while running it: it ran out of "
+                                           "memory (the limit of a child process is 2 GB; set AR3CLI_CHILD_MEMORY_MB")
+    monkeypatch.setenv(child_limits.MEMORY_VARIABLE, "0")
+    with pytest.raises(CrashError, match=r"\(SIGABRT\) while running it: a bug in pybullet's C code"):
+        run_isolated(os.abort, "robot.urdf")

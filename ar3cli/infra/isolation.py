@@ -200,6 +200,12 @@ def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
     else:
         name = f"exit {code}"
     reason = cause() if cause is not None else None
-    explanation = (f"; {reason}" if reason else
-                   f": a bug in pybullet's C code that this file triggers (see 'ar3cli lint-urdf {subject}')")
+    if reason:
+        explanation = f"; {reason}"
+    elif name == "SIGABRT" and child_limits.memory_limit() is not None:  # how C++ ends when memory runs out
+        explanation = (f": it ran out of memory (the limit of a child process is {child_limits.describe_memory_limit()}; "
+                       f"set {child_limits.MEMORY_VARIABLE} to change it), or a bug in pybullet's C code that this "
+                       f"file triggers (see 'ar3cli lint-urdf {subject}')")
+    else:
+        explanation = f": a bug in pybullet's C code that this file triggers (see 'ar3cli lint-urdf {subject}')"
     raise CrashError(f"{subject}: pybullet crashed ({name}) while {stage}{explanation}", name, stage)
