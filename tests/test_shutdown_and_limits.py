@@ -226,3 +226,17 @@ def test_a_c_abort_under_the_memory_limit_names_both_likely_causes(monkeypatch) 
     monkeypatch.setenv(child_limits.MEMORY_VARIABLE, "0")
     with pytest.raises(CrashError, match=r"\(SIGABRT\) while running it: a bug in pybullet's C code"):
         run_isolated(os.abort, "robot.urdf")
+
+
+def test_a_child_whose_parent_died_before_it_asked_to_die_with_it_ends_at_once() -> None:
+    """PR_SET_PDEATHSIG only covers a parent that dies after the request: the child compares its
+    parent with the one it was forked from and ends if they differ (here: a pid that is not its parent)."""
+    child_limits.prepare()
+    pid = os.fork()
+    if pid == 0:  # pragma: no cover - the child
+        try:
+            child_limits.enter_child(parent=os.getpid())
+        finally:
+            os._exit(0)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 1
