@@ -68,16 +68,22 @@ def unwrap(outcome: Outcome, where: str = "") -> Any:
     raise RuntimeError(f"{where}{payload}")
 
 
+WRITER_GRACE_S = 0.5
+
+
 def read_until(fd: int, deadline: float | None) -> tuple[bytes, bool]:
     """Everything written to the pipe ``fd`` until its end, or until ``deadline``
     (``time.monotonic()``; None: no limit) passes with nothing more to read: (the bytes, whether
-    the end was reached). A writer still writing is never cut off while its data keeps coming."""
+    the end was reached). A writer still writing is not cut off while its data keeps coming: once
+    something came, each wait lasts at least :data:`WRITER_GRACE_S` (a large answer fills the pipe,
+    and the writer must be scheduled again to write the rest)."""
     import select
 
     chunks: list[bytes] = []
     while True:
         if deadline is not None:
-            ready, _, _ = select.select([fd], [], [], max(0.0, deadline - time.monotonic()))
+            wait = max(WRITER_GRACE_S if chunks else 0.0, deadline - time.monotonic())
+            ready, _, _ = select.select([fd], [], [], wait)
             if not ready:
                 return b"".join(chunks), False
         chunk = os.read(fd, 1 << 16)
