@@ -94,8 +94,8 @@ def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], s
         data, finished = read_until(child[1].fileno(), None if seconds is None else time.monotonic() + seconds)
         answer, stage = _messages(data)
         if not finished:
-            raise ChildTimeoutError(f"{subject}: timed out after {seconds:g} s while {stage}; raise --timeout (0: no "
-                                "limit) if the file is just large", "timeout", stage)
+            raise ChildTimeoutError(f"{subject}: timed out after {seconds:g} s while {stage}; raise --timeout "
+                                    "(0: no limit) if the file is just large", "timeout", stage)
         child[1].close()
         status = _reap(child[0])
         child = None
