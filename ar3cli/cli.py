@@ -2,7 +2,8 @@
 
 Exit codes: 0 ok, 1 problems found / check failed, 2 usage or I/O error (bad input gets a one-line
 ``ar3cli: error: ...`` on stderr, never a traceback), 3 a bug in ar3cli (one line too; set
-``AR3CLI_DEBUG=1`` to see the traceback).
+``AR3CLI_DEBUG=1`` to see the traceback), 130 Ctrl-C, 143 SIGTERM (both stop the children and remove
+the temporary folders first, see :mod:`ar3cli.infra.shutdown`).
 """
 
 import os
@@ -97,14 +98,32 @@ def main(argv: list[str] | None = None) -> None:
 
     Usage errors (a bad option value, a missing argument) are shortened from click's multi-line
     box to ``ar3cli: error: <what> (see 'ar3cli COMMAND --help')`` with exit code 2, like every
-    other input error.
+    other input error. SIGTERM is handled as Ctrl-C is, with exit code 143.
     """
+    from ar3cli.infra import shutdown
+
     _reopen_closed_standard_streams()
+    with shutdown.terminate_like_interrupt():
+        _main(argv)
+
+
+def _interrupted() -> None:
+    """Exit after Ctrl-C (130) or SIGTERM (143), with one line saying which."""
+    from ar3cli.infra import shutdown
+
+    if shutdown.received():
+        print("ar3cli: terminated", file=sys.stderr)
+        sys.exit(shutdown.EXIT_TERMINATED)
+    print("ar3cli: interrupted", file=sys.stderr)
+    sys.exit(130)
+
+
+def _main(argv: list[str] | None) -> None:
     usage_error, no_args = _click_exceptions()
     try:
         code = application(argv)(args=argv, prog_name="ar3cli", standalone_mode=False)
         if code == 130:  # typer turns Ctrl-C into Exit(130)
-            print("ar3cli: interrupted", file=sys.stderr)
+            _interrupted()
         sys.exit(code if isinstance(code, int) else 0)
     except no_args as exc:  # `ar3cli` alone, or a group without a command: show the help
         exc.show()
@@ -115,14 +134,12 @@ def main(argv: list[str] | None = None) -> None:
         print(f"ar3cli: error: {message} (see '{command} --help')", file=sys.stderr)
         sys.exit(EXIT_USAGE)
     except typer.Abort:
-        print("ar3cli: interrupted", file=sys.stderr)
-        sys.exit(130)
+        _interrupted()
     except UserError as exc:
         print(f"ar3cli: error: {exc.message}", file=sys.stderr)
         sys.exit(exc.exit_code)
     except KeyboardInterrupt:
-        print("ar3cli: interrupted", file=sys.stderr)
-        sys.exit(130)
+        _interrupted()
     except Exception as exc:  # a bug in ar3cli: one line unless debugging
         if os.environ.get("AR3CLI_DEBUG"):
             raise
@@ -138,10 +155,12 @@ def run() -> None:
     about to end and took ~20 ms after a 95-file lint (measured with benchmarks/bench_lint.py's
     files). So the exit handlers run (caches are saved, temporary folders removed), the streams
     are flushed, and the process ends with ``os._exit``. In-process callers use :func:`main`,
-    which raises SystemExit as usual.
+    which raises SystemExit as usual. A SIGTERM once the command is done is ignored: the exit
+    handlers finish in milliseconds, and one cut short would leave a temporary file.
     """
     import atexit
     import contextlib
+    import signal
 
     try:
         main()
@@ -151,6 +170,8 @@ def run() -> None:
     if isinstance(code, str):  # what sys.exit("message") would print
         print(code, file=sys.stderr)
         code = 1
+    if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)
     atexit._run_exitfuncs()  # noqa: SLF001 - atexit's own runner: the handlers run now, not at teardown
     for stream in (sys.stdout, sys.stderr):
         with contextlib.suppress(OSError, ValueError):  # closed or full: the output layer has said so

@@ -13,7 +13,7 @@ from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import PackagePathOption, SeedOption, XacroArgOption, samples_option
+from ar3cli.commands.options import PackagePathOption, SeedOption, XacroArgOption, finite_float, samples_option
 from ar3cli.errors import UserError
 from ar3cli.output.report import finish
 
@@ -36,12 +36,14 @@ ChangedSinceOption = Annotated[Optional[str], typer.Option(
 SamplesOption = Annotated[int, samples_option("Random configurations of the shared joints, on top of the home pose.",
                                               most=100_000)]
 ToleranceOption = Annotated[float, typer.Option(
-    "--tolerance", help="What counts as a change: metres for lengths, radians for angles, and a fraction of the "
-                        "larger value for masses, inertias, efforts and velocities.")]
-ToleranceMOption = Annotated[Optional[float], typer.Option("--tolerance-m", show_default=False,
-                                                           help="Length tolerance (m); default: --tolerance.")]
-ToleranceRadOption = Annotated[Optional[float], typer.Option("--tolerance-rad", show_default=False,
-                                                             help="Angle tolerance (rad); default: --tolerance.")]
+    "--tolerance", click_type=finite_float(),
+    help="What counts as a change: metres for lengths, radians for angles, and a fraction of the "
+         "larger value for masses, inertias, efforts and velocities.")]
+ToleranceMOption = Annotated[Optional[float], typer.Option(
+    "--tolerance-m", show_default=False, click_type=finite_float(), help="Length tolerance (m); default: --tolerance.")]
+ToleranceRadOption = Annotated[Optional[float], typer.Option(
+    "--tolerance-rad", show_default=False, click_type=finite_float(),
+    help="Angle tolerance (rad); default: --tolerance.")]
 FormatOption = Annotated[DiffFormat, typer.Option(
     "--format", "-f", help="text (tables), json (one document on stdout), markdown (for a pull-request comment) "
                            "or github (workflow annotations; the Markdown is appended to $GITHUB_STEP_SUMMARY).")]

@@ -13,9 +13,11 @@ from ar3cli.commands.options import (
     OutputOption,
     PackagePathOption,
     SeedOption,
+    TimeoutOption,
     finite_float,
     samples_option,
 )
+from ar3cli.infra.child_limits import LONG_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -48,6 +50,7 @@ def fix_collision(
     follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = LONG_TIMEOUT_S,
 ) -> None:
     """Replace a collision mesh that collides as a much larger convex hull by convex parts.
 

@@ -13,8 +13,10 @@ from ar3cli.commands.options import (
     FormatOption,
     OutputOption,
     PackagePathOption,
+    TimeoutOption,
     finite_float,
 )
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -39,6 +41,7 @@ def fix_continuous(
     follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Fix continuous joints: lower/upper on a continuous joint only add a PyBullet position clamp.
 

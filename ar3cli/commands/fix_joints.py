@@ -13,8 +13,10 @@ from ar3cli.commands.options import (
     FormatOption,
     OutputOption,
     PackagePathOption,
+    TimeoutOption,
     finite_float,
 )
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -37,6 +39,7 @@ def fix_joints(
     follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
 

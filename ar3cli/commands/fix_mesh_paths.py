@@ -12,7 +12,9 @@ from ar3cli.commands.options import (
     FormatOption,
     OutputOption,
     PackagePathOption,
+    TimeoutOption,
 )
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat
 
 
@@ -31,6 +33,7 @@ def fix_mesh_paths(
     follow_symlinks: FollowSymlinksOption = False,
     package_path: PackagePathOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Rewrite machine-bound mesh and texture URIs to `package://NAME/...`, byte for byte, atomically.
 

@@ -10,6 +10,7 @@ from ar3cli.commands.options import (
     PackagePathOption,
     RobotPathArgument,
     SeedOption,
+    TimeoutOption,
     XacroArgOption,
     XacroEnvOption,
     XacroMode,
@@ -18,6 +19,7 @@ from ar3cli.commands.options import (
     samples_option,
 )
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat, finish
 from ar3cli.urdf.loading import load_with_specs
 
@@ -46,6 +48,7 @@ def fk_verify(
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Check that PyBullet (and your DH table) put every link frame where the URDF says.
 

@@ -12,6 +12,7 @@ from ar3cli.commands.options import (
     PackagePathOption,
     RobotPathArgument,
     SeedOption,
+    TimeoutOption,
     XacroArgOption,
     XacroEnvOption,
     XacroMode,
@@ -19,6 +20,7 @@ from ar3cli.commands.options import (
     samples_option,
 )
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import OutputFormat, finish
 from ar3cli.urdf.loading import load_with_specs
 
@@ -45,6 +47,7 @@ def info(
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Show what a robot is made of: kinematic tree, DOF and joint limits, masses and centre of mass,
     bounding box, meshes, end effectors.

@@ -9,15 +9,14 @@ import typer
 from ar3cli.commands.options import (
     FollowSymlinksOption,
     PackagePathOption,
+    TimeoutOption,
     XacroArgOption,
     XacroEnvOption,
     XacroMode,
     XacroModeOption,
 )
-from ar3cli.errors import (
-    EXIT_USAGE,
-    UserError,
-)
+from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.report import Report, Table, finish
 
 
@@ -107,6 +106,7 @@ def lint_urdf(
         "--srdf", metavar="FILE.srdf", dir_okay=False,
         help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
     = None,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Check URDF and xacro files for mistakes that break ROS tools or make PyBullet misbehave.
 

@@ -108,3 +108,20 @@ FollowSymlinksOption = Annotated[bool, typer.Option(
     "--follow-symlinks", help="Write through an output path (or an in-place fix's file) that is a symbolic link, "
                               "replacing the link's target. Without it such a path is refused: a link planted "
                               "in a repository must not redirect a write.")]
+
+
+def _apply_timeout(seconds: float) -> float:
+    """Set the child processes' time limit as the option is parsed (every command that has it)."""
+    from ar3cli.infra.child_limits import set_timeout
+
+    set_timeout(seconds)
+    return seconds
+
+
+TimeoutOption = Annotated[float, typer.Option(
+    "--timeout", metavar="SECONDS", click_type=finite_float(min=0), callback=_apply_timeout,
+    help="Wall-clock limit per file for the process that runs pybullet (or a decomposition) on it: one that "
+         "takes longer is stopped, and the file gets a one-line error. 0: no limit. Each such process may also "
+         "map at most half of the memory (1-4 GB; AR3CLI_CHILD_MEMORY_MB sets it).")]
+"""``--timeout``: commands give the default (:data:`~ar3cli.infra.child_limits.DEFAULT_TIMEOUT_S`, or
+:data:`~ar3cli.infra.child_limits.LONG_TIMEOUT_S` for sample-collisions and fix-collision)."""

@@ -10,19 +10,15 @@ from ar3cli.commands.options import (
     FormatOption,
     PackagePathOption,
     RobotPathArgument,
+    TimeoutOption,
     XacroArgOption,
     XacroEnvOption,
     XacroMode,
     XacroModeOption,
     finite_float,
 )
-from ar3cli.output.report import (
-    OutputFormat,
-    Report,
-    Table,
-    finish,
-    log,
-)
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
+from ar3cli.output.report import OutputFormat, Report, Table, finish, log
 from ar3cli.urdf.loading import load_with_specs
 
 
@@ -46,6 +42,7 @@ def render_command(
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
     format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.
 

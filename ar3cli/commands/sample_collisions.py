@@ -11,6 +11,7 @@ from ar3cli.commands.options import (
     PackagePathOption,
     RobotPathArgument,
     SeedOption,
+    TimeoutOption,
     XacroArgOption,
     XacroEnvOption,
     XacroMode,
@@ -19,6 +20,7 @@ from ar3cli.commands.options import (
     samples_option,
 )
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import LONG_TIMEOUT_S
 from ar3cli.output.report import OutputFormat, finish
 from ar3cli.urdf.loading import load_with_specs
 
@@ -71,6 +73,7 @@ def sample_collisions(
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
+    timeout: TimeoutOption = LONG_TIMEOUT_S,
 ) -> None:
     """Sample joint configurations and classify every link pair as MoveIt Setup Assistant does.
 

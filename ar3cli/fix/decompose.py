@@ -13,7 +13,9 @@ hulls hug it:
   run with a fixed seed, so deterministic too.
 
 Both are C++ code that may crash on odd input, so each runs in a forked child
-(:func:`ar3cli.infra.isolation.run_isolated`): a crash is one line naming the mesh. Every part is
+(:func:`ar3cli.infra.isolation.run_isolated`): a crash is one line naming the mesh, and so is a
+decomposition that outgrows the child's memory cap or its ``--timeout`` (per mesh; see
+:mod:`ar3cli.infra.child_limits`: a high ``--resolution`` takes minutes on a large mesh). Every part is
 written as its convex hull (computed with trimesh), so each part's own hull/mesh ratio is 1 and a
 second fix-collision run leaves it alone. Parts stay in the source mesh's units: the ``scale`` of
 the ``<mesh>`` element is kept and applies to them as it did to the original.

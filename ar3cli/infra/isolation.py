@@ -7,6 +7,12 @@ through a pipe. When the child dies instead, the caller gets a one-line :class:`
 naming the signal and what pybullet was doing then (:func:`report_stage`, which the child calls
 as it goes: "loading it", "rendering it", ...).
 
+Limits (:mod:`ar3cli.infra.child_limits`): the child has a capped address space and dies with this
+process; this process waits for its answer at most :func:`~ar3cli.infra.child_limits.timeout`
+seconds (the command's ``--timeout``), then stops it: ``robot.urdf: timed out after 120 s while
+loading it; ...`` (:class:`ChildTimeoutError`). A child out of memory is :class:`OutOfMemoryError`. Both
+are CrashErrors: whoever reports a crash as a file's error reports them the same way.
+
 Temporary files: a process killed by a signal runs no ``finally`` and no ``atexit``, so the child
 makes its temporary files in a folder this process created, and this process removes it
 whatever happened. Where fork is not available (Windows, macOS), the work runs in this process.
@@ -15,6 +21,7 @@ whatever happened. Where fork is not available (Windows, macOS), the work runs i
 from __future__ import annotations
 
 import contextlib
+import io
 import os
 import pickle
 import shutil
@@ -25,8 +32,9 @@ from collections.abc import Callable
 from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import EXIT_USAGE, UserError
-from ar3cli.infra.outcome import capture, pickled, unwrap
-from ar3cli.infra.process_pool import can_fork, child_signals, sigint_deferred, stop_children
+from ar3cli.infra import child_limits, shutdown
+from ar3cli.infra.outcome import OutOfMemory, capture, pickled, read_until, unwrap
+from ar3cli.infra.process_pool import can_fork, child_signals, interrupts_deferred, stop_children
 
 Result = TypeVar("Result")
 
@@ -44,40 +52,63 @@ class CrashError(UserError):
         self.stage = stage
 
 
+class ChildTimeoutError(CrashError):
+    """The isolated child did not answer within the timeout and was stopped; exit code 2."""
+
+
+class OutOfMemoryError(CrashError):
+    """The isolated child reached its memory limit (a MemoryError in Python); exit code 2."""
+
+
 def report_stage(stage: str) -> None:
     """Tell the parent what the child is about to do (quoted if the child dies); a no-op elsewhere."""
     if _stage_pipe is not None:
         _send(_stage_pipe, ("stage", stage))
 
 
-def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], str | None] | None = None) -> Result:
+def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], str | None] | None = None,
+                 timeout: float | None = None) -> Result:
     """``work()`` in a forked child; its result (which must pickle) or its exception comes back.
 
     A UserError in the child is raised here as it was; any other exception becomes a RuntimeError
     (an internal error); a child that dies raises :class:`CrashError`, e.g.
     ``ur5.urdf: pybullet crashed (SIGSEGV) while loading it``, ``subject`` being the file, followed
-    by what ``cause()`` says is the likely reason (asked only after a crash), if anything.
-    Ctrl-C stops the child (it gets a moment to finish, then SIGTERM, then SIGKILL).
+    by what ``cause()`` says is the likely reason (asked only after a crash), if anything. A child
+    that has not answered after ``timeout`` seconds (None: the command's ``--timeout``; 0 or
+    infinity: no limit) is stopped and :class:`ChildTimeoutError` raised; a MemoryError in the child is
+    :class:`OutOfMemoryError`. Ctrl-C or SIGTERM stops the child (after Ctrl-C, which it got too,
+    it gets a moment to finish; then SIGTERM, then SIGKILL).
     """
     if not can_fork():
         return work()
+    import time
+
+    seconds = child_limits.timeout() if timeout is None else (timeout if 0 < timeout < float("inf") else None)
     folder = tempfile.mkdtemp(prefix="ar3cli-")
     child: tuple[int, BinaryIO] | None = None
-    interrupted = False
+    settle = False
     try:
-        with sigint_deferred() as mask:  # a Ctrl-C between fork and bookkeeping would lose the child
+        child_limits.prepare()
+        with interrupts_deferred() as mask:  # a Ctrl-C between fork and bookkeeping would lose the child
             child = _start(work, folder, mask)
-        answer, stage = _collect(child[1])
+        data, finished = read_until(child[1].fileno(), None if seconds is None else time.monotonic() + seconds)
+        answer, stage = _messages(data)
+        if not finished:
+            raise ChildTimeoutError(f"{subject}: timed out after {seconds:g} s while {stage}; raise --timeout "
+                                    "(0: no limit) if the file is just large", "timeout", stage)
+        child[1].close()
         status = _reap(child[0])
         child = None
         return _unpack(answer, stage, status, subject, cause)
-    except KeyboardInterrupt:
-        interrupted = True
+    except KeyboardInterrupt as exc:
+        settle = shutdown.settle_after(exc)
         raise
     finally:
-        if child is not None:
-            stop_children([child], settle=interrupted)
-        shutil.rmtree(folder, ignore_errors=True)
+        try:
+            if child is not None:
+                stop_children([child], settle=settle)
+        finally:  # a second Ctrl-C, delivered once the child is stopped, must not keep the folder
+            shutil.rmtree(folder, ignore_errors=True)
 
 
 def _start(work: Callable[[], Result], folder: str, mask: set[signal.Signals]) -> tuple[int, BinaryIO]:
@@ -85,6 +116,7 @@ def _start(work: Callable[[], Result], folder: str, mask: set[signal.Signals]) -
     for stream in (sys.stdout, sys.stderr):
         stream.flush()  # what is buffered now must not be written twice
     read_end, write_end = os.pipe()
+    parent = os.getpid()
     try:
         pid = os.fork()
     except OSError as exc:
@@ -93,7 +125,7 @@ def _start(work: Callable[[], Result], folder: str, mask: set[signal.Signals]) -
         raise UserError(f"cannot start a process for pybullet: {exc.strerror or exc}") from None
     if pid == 0:  # the child: never returns
         try:
-            child_signals(mask)
+            child_signals(mask, parent)
             os.close(read_end)
             _run_child(work, folder, os.fdopen(write_end, "wb"))
         finally:
@@ -125,19 +157,19 @@ def _send(pipe: BinaryIO, message: tuple) -> None:
     pipe.flush()
 
 
-def _collect(pipe: BinaryIO) -> tuple[tuple | None, str]:
-    """Read the child's messages to the end: (its final answer or None, the last stage it named)."""
+def _messages(data: bytes) -> tuple[tuple | None, str]:
+    """The child's messages, read to the end: (its final answer or None, the last stage it named)."""
     stage, answer = DEFAULT_STAGE, None
-    with pipe:
-        while True:
-            try:
-                kind, payload = pickle.load(pipe)
-            except (EOFError, pickle.UnpicklingError, ValueError, TypeError):
-                break  # the end, or a message cut short by the child's death
-            if kind == "stage":
-                stage = payload
-            else:
-                answer = (kind, payload)
+    stream = io.BytesIO(data)
+    while True:
+        try:
+            kind, payload = pickle.load(stream)
+        except (EOFError, pickle.UnpicklingError, ValueError, TypeError):
+            break  # the end, or a message cut short by the child's death
+        if kind == "stage":
+            stage = payload
+        else:
+            answer = (kind, payload)
     return answer, stage
 
 
@@ -155,7 +187,10 @@ def _reap(pid: int) -> int:
 def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
             cause: Callable[[], str | None] | None) -> Result:
     if answer is not None:
-        return unwrap(answer)
+        try:
+            return unwrap(answer)
+        except OutOfMemory as exc:
+            raise OutOfMemoryError(f"{subject}: {exc.message} while {stage}", "MemoryError", stage) from None
     code = os.waitstatus_to_exitcode(status)
     if code < 0:
         try:
@@ -165,6 +200,12 @@ def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
     else:
         name = f"exit {code}"
     reason = cause() if cause is not None else None
-    explanation = (f"; {reason}" if reason else
-                   f": a bug in pybullet's C code that this file triggers (see 'ar3cli lint-urdf {subject}')")
+    if reason:
+        explanation = f"; {reason}"
+    elif name == "SIGABRT" and child_limits.memory_limit() is not None:  # how C++ ends when memory runs out
+        explanation = (f": it ran out of memory (the limit of a child process is {child_limits.describe_memory_limit()}; "
+                       f"set {child_limits.MEMORY_VARIABLE} to change it), or a bug in pybullet's C code that this "
+                       f"file triggers (see 'ar3cli lint-urdf {subject}')")
+    else:
+        explanation = f": a bug in pybullet's C code that this file triggers (see 'ar3cli lint-urdf {subject}')"
     raise CrashError(f"{subject}: pybullet crashed ({name}) while {stage}{explanation}", name, stage)

@@ -2,15 +2,19 @@
 
 Both ways of running work in a child (:mod:`ar3cli.infra.process_pool` for shares of a list,
 :mod:`ar3cli.infra.isolation` for pybullet work that may crash) send the same answer through a
-pipe: ``("ok", result)``, ``("user-error", (message, exit code))``, ``("interrupted", None)`` or
-``("error", "Type: text")``, pickled. The parent turns it back into the result or into the
+pipe: ``("ok", result)``, ``("user-error", (message, exit code))``, ``("interrupted", None)``,
+``("out-of-memory", "Type: text")`` (the child reached its memory limit, see
+:mod:`ar3cli.infra.child_limits`) or ``("error", "Type: text")``, pickled; :func:`read_until` reads it
+within a time limit. The parent turns it back into the result or into the
 exception as it would have been raised in this process (a bug becomes a RuntimeError: the
 traceback stayed in the child).
 """
 
 from __future__ import annotations
 
+import os
 import pickle
+import time
 from collections.abc import Callable
 from typing import Any, TypeVar
 
@@ -18,6 +22,10 @@ from ar3cli.errors import UserError
 
 Result = TypeVar("Result")
 Outcome = tuple[str, Any]
+
+
+class OutOfMemory(UserError):
+    """A child reached its memory limit (MemoryError in Python); exit code 2."""
 
 
 def capture(work: Callable[[], Result]) -> Outcome:
@@ -28,6 +36,8 @@ def capture(work: Callable[[], Result]) -> Outcome:
         return "user-error", (exc.message, exc.exit_code)
     except KeyboardInterrupt:
         return "interrupted", None
+    except MemoryError as exc:
+        return "out-of-memory", f"{type(exc).__name__}: {exc}"
     except BaseException as exc:  # noqa: BLE001 - reported by the parent as an internal error
         return "error", f"{type(exc).__name__}: {exc}"
 
@@ -50,4 +60,33 @@ def unwrap(outcome: Outcome, where: str = "") -> Any:
         raise UserError(*payload)
     if kind == "interrupted":
         raise KeyboardInterrupt
+    if kind == "out-of-memory":
+        from ar3cli.infra.child_limits import MEMORY_VARIABLE, describe_memory_limit
+
+        raise OutOfMemory(f"{where}ran out of memory (the limit of a child process is {describe_memory_limit()}; "
+                          f"set {MEMORY_VARIABLE} to change it)")
     raise RuntimeError(f"{where}{payload}")
+
+
+WRITER_GRACE_S = 0.5
+
+
+def read_until(fd: int, deadline: float | None) -> tuple[bytes, bool]:
+    """Everything written to the pipe ``fd`` until its end, or until ``deadline``
+    (``time.monotonic()``; None: no limit) passes with nothing more to read: (the bytes, whether
+    the end was reached). A writer still writing is not cut off while its data keeps coming: once
+    something came, each wait lasts at least :data:`WRITER_GRACE_S` (a large answer fills the pipe,
+    and the writer must be scheduled again to write the rest)."""
+    import select
+
+    chunks: list[bytes] = []
+    while True:
+        if deadline is not None:
+            wait = max(WRITER_GRACE_S if chunks else 0.0, deadline - time.monotonic())
+            ready, _, _ = select.select([fd], [], [], wait)
+            if not ready:
+                return b"".join(chunks), False
+        chunk = os.read(fd, 1 << 16)
+        if not chunk:
+            return b"".join(chunks), True
+        chunks.append(chunk)

@@ -7,6 +7,9 @@ start, as much as linting 20 files). This process takes a share of the work itse
 sends its results back pickled through a pipe and ends with ``os._exit`` (no atexit handler runs
 twice, no inherited output buffer is flushed twice). Elsewhere (Windows, macOS: forking is not
 safe there) everything runs in this process.
+
+Every child lives under :mod:`ar3cli.infra.child_limits` (memory cap, death with its parent) and
+stops cleanly on SIGTERM (:mod:`ar3cli.infra.shutdown`).
 """
 
 from __future__ import annotations
@@ -19,7 +22,8 @@ from collections.abc import Callable, Iterator, Sequence
 from typing import BinaryIO, TypeVar
 
 from ar3cli.errors import UserError
-from ar3cli.infra.outcome import capture, pickled, unwrap
+from ar3cli.infra import child_limits, shutdown
+from ar3cli.infra.outcome import capture, pickled, read_until, unwrap
 
 Item = TypeVar("Item")
 Result = TypeVar("Result")
@@ -53,22 +57,31 @@ def worker_count(requested: int | None, items: int, min_items_per_worker: int) -
 
 
 def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], workers: int,
-                     what: str = "a worker") -> list[Result]:
+                     what: str = "a worker", timeout: float | None = None) -> list[Result]:
     """``[function(item) for item in items]`` with the items dealt round-robin to ``workers``
     processes, this one included. Results must pickle. A child's UserError is raised here as it
     is, any other exception as a RuntimeError (an internal error); a child that dies (a crash in C
     code) becomes a one-line UserError naming ``what`` was running. Never a hang: if this process
     fails or is interrupted, the children are stopped (given time to clean up first); a child whose
-    parent died stops at its next item. When the system refuses another process or pipe, this
-    process takes that share itself."""
+    parent died is killed (:func:`~ar3cli.infra.child_limits.enter_child`). A child gets ``timeout``
+    seconds per item (None: the command's ``--timeout``), plus the time to stop a child of its own,
+    before it is stopped and that is a one-line UserError. When the system refuses another process
+    or pipe, this process takes that share itself."""
     if workers <= 1 or len(items) <= 1 or not can_fork():
         return [function(item) for item in items]
+    import time
+
     workers = min(workers, len(items))
+    per_item = child_limits.timeout() if timeout is None else timeout
     children: dict[int, tuple[int, BinaryIO]] = {}  # share number -> (pid, the pipe it answers through)
-    interrupted = False
+    deadlines: dict[int, float | None] = {}
+    settle = False
+    child_limits.prepare()
     try:
         for number in range(1, workers):
-            with sigint_deferred() as mask:  # a Ctrl-C now would lose the new child's pid
+            share_size = len(items[number::workers])
+            deadlines[number] = None if per_item is None else time.monotonic() + share_size * (per_item + STOP_SECONDS)
+            with interrupts_deferred() as mask:  # a Ctrl-C now would lose the new child's pid
                 child = _start_child(function, items[number::workers], [pipe for _, pipe in children.values()], mask)
                 if child is not None:
                     children[number] = child
@@ -77,14 +90,19 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
         shares = {number: [function(item) for item in items[number::workers]]
                   for number in range(workers) if number not in children}
         for number, (pid, pipe) in list(children.items()):
-            data = _read_and_reap(pid, pipe)
+            data, finished = read_until(pipe.fileno(), deadlines[number])
+            if not finished:
+                raise UserError(f"{what} process timed out after {per_item:g} s per item; raise --timeout "
+                                "(0: no limit) if the input is just large")
+            pipe.close()
+            os.waitpid(pid, 0)
             del children[number]
             shares[number] = _unpack(data, what)
-    except KeyboardInterrupt:
-        interrupted = True
+    except KeyboardInterrupt as exc:
+        settle = shutdown.settle_after(exc)
         raise
     finally:
-        stop_children(list(children.values()), settle=interrupted)  # this process failed or was interrupted
+        stop_children(list(children.values()), settle=settle)  # this process failed or was interrupted
     results: list[Result] = [None] * len(items)  # type: ignore[list-item]
     for number, share in shares.items():
         results[number::workers] = share
@@ -92,28 +110,26 @@ def map_in_processes(function: Callable[[Item], Result], items: Sequence[Item], 
 
 
 @contextlib.contextmanager
-def sigint_deferred() -> Iterator[set[signal.Signals]]:
-    """SIGINT held back (delivered on leaving); yields the mask to restore in a forked child."""
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+def interrupts_deferred() -> Iterator[set[signal.Signals]]:
+    """SIGINT and SIGTERM held back (delivered on leaving); yields the mask to restore in a forked child."""
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM})
     try:
         yield previous
     finally:
         signal.pthread_sigmask(signal.SIG_SETMASK, previous)
 
 
-def child_signals(mask: set[signal.Signals]) -> None:
-    """In a forked child, first: SIGTERM raises KeyboardInterrupt, then the parent's signal
-    ``mask`` is restored. SIGTERM is how :func:`stop_children` asks a child to stop so that its
-    ``finally`` blocks run (a PyBullet session removes its folder). SIGINT stays as the parent had
-    it: a background job (``ar3cli ... &``, a CI step) is started with SIGINT ignored, and so stays
-    uninterruptible, children included; asking with SIGINT found such a child deaf, and it was
-    killed 3 s later without cleaning up."""
-    signal.signal(signal.SIGTERM, _stop_requested)
+def child_signals(mask: set[signal.Signals], parent: int) -> None:
+    """In a forked child, first: the limits of :func:`~ar3cli.infra.child_limits.enter_child` (it
+    dies with ``parent``), SIGTERM raises KeyboardInterrupt (:func:`~ar3cli.infra.shutdown.in_child`),
+    then the parent's signal ``mask`` is restored. SIGTERM is how :func:`stop_children` asks a child
+    to stop so that its ``finally`` blocks run (a PyBullet session removes its folder). SIGINT stays
+    as the parent had it: a background job (``ar3cli ... &``, a CI step) is started with SIGINT
+    ignored, and so stays uninterruptible, children included; asking with SIGINT found such a
+    child deaf, and it was killed 3 s later without cleaning up."""
+    child_limits.enter_child(parent)
+    shutdown.in_child()
     signal.pthread_sigmask(signal.SIG_SETMASK, mask)
-
-
-def _stop_requested(_signal_number: int, _frame: object) -> None:
-    raise KeyboardInterrupt
 
 
 def _start_child(function: Callable[[Item], Result], share: Sequence[Item], siblings: list[BinaryIO],
@@ -135,7 +151,7 @@ def _start_child(function: Callable[[Item], Result], share: Sequence[Item], sibl
         return None
     if pid == 0:  # the child: never returns
         try:
-            child_signals(mask)
+            child_signals(mask, parent)
             os.close(read_end)
             for pipe in siblings:
                 pipe.close()
@@ -153,14 +169,6 @@ def _unless_orphaned(parent: int, function: Callable[[Item], Result], item: Item
     if os.getppid() != parent:
         os._exit(1)
     return function(item)
-
-
-def _read_and_reap(pid: int, pipe: BinaryIO) -> bytes:
-    """Everything the child wrote (read to the end first, so a large answer cannot block it)."""
-    with pipe:
-        data = pipe.read()
-    os.waitpid(pid, 0)
-    return data
 
 
 def _unpack(data: bytes, what: str) -> list[Result]:
@@ -185,10 +193,10 @@ STOP_SECONDS = 3.0
 def stop_children(children: list[tuple[int, BinaryIO]], settle: bool) -> None:
     """End the remaining children: closed pipes, a moment to finish after Ctrl-C (``settle``),
     SIGTERM (which a forked child turns into KeyboardInterrupt), then SIGKILL. A second Ctrl-C
-    meanwhile waits until they are gone (a few seconds at most), so none is left running."""
+    meanwhile (or SIGTERM) waits until they are gone (a few seconds at most), so none is left running."""
     if not children:
         return
-    with sigint_deferred():
+    with interrupts_deferred():
         for _, pipe in children:
             pipe.close()  # a child still writing its answer gets EPIPE and ends
         running = {pid for pid, _ in children}
