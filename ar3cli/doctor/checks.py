@@ -206,13 +206,18 @@ CHECKS: list[Callable[[], Check]] = [
 
 
 def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
-    """Run every check, each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside one
+    """Run ``checks`` (default: :data:`CHECKS`, then one per capability of
+    :mod:`ar3cli.doctor.capabilities`), each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside one
     becomes a ``fail`` for that check only, and so does a crash of pybullet's C code (a broken
     build), which would otherwise end install-check with no report at all."""
     from ar3cli.infra.isolation import CrashError, run_isolated
 
+    if checks is None:
+        from ar3cli.doctor.capabilities import CAPABILITY_CHECKS
+
+        checks = [*CHECKS, *CAPABILITY_CHECKS]
     results = []
-    for check in checks or CHECKS:
+    for check in checks:
         name = check.__name__.removeprefix("check_")
         try:
             result = run_isolated(functools.partial(_run_one, check), f"install-check {name}")
