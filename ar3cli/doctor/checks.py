@@ -227,6 +227,8 @@ def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
         results.append(result)
         if result.name == "pybullet" and result.status == "ok":
             import_pybullet_here()
+        if result.name == "trimesh" and result.status == "ok":
+            import trimesh  # noqa: F401 - the capability checks' children inherit it (~0.5 s each otherwise)
     return results
 
 
