@@ -67,6 +67,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import json
 import os
 import re
@@ -533,37 +534,54 @@ def second_look(runner: Runner, command: Command, path: Path, outcome: Outcome, 
     return ""
 
 
+@functools.lru_cache(maxsize=16)
+def _parsed(path: str) -> tuple[bytes, object] | None:
+    """The robot file's bytes and lxml tree (each finding of a file looks at the same file)."""
+    from lxml import etree
+
+    try:
+        text = Path(path).read_bytes()
+        return text, etree.fromstring(text, etree.XMLParser(resolve_entities=False, no_network=True))
+    except (OSError, etree.XMLSyntaxError, ValueError):
+        return None
+
+
 def line_problem(path: object, line: object, message: str, need_name: bool = True) -> str:
-    """'' when line ``line`` of ``path`` (or the element it is inside) holds the thing ``message`` names;
-    without a name, when the line exists (``need_name=False``) or nothing can be said."""
+    """'' when line ``line`` of ``path`` is inside an element that holds the thing ``message`` names.
+
+    The element at a line is the last one whose start tag begins at or before it (a multi-line start
+    tag included); it holds the thing when an attribute of it, of an element inside it, or of an element
+    around it has that value (a link or joint name) or contains it (a mesh file name, an extension):
+    the ``<inertia>`` line of ``link 'a'`` holds it, a ``<transmission>`` holds the joint it drives.
+    Without a name only the line's existence is checked (``need_name=False``)."""
     named = NAMED.search(message)
     if not isinstance(path, str) or not isinstance(line, int) or line < 1 or path.endswith(".xacro"):
         return ""
     if not named and need_name:
         return ""
-    try:
-        lines = Path(path).read_text(encoding="utf-8", errors="replace").splitlines()
-    except OSError:
+    parsed = _parsed(path)
+    if parsed is None:
         return ""
-    if line > len(lines):
-        return f"{Path(path).name}:{line}, a line the file does not have ({len(lines)} lines)"
+    text, root = parsed
+    count = text.count(b"\n") + (not text.endswith(b"\n"))
+    if line > count:
+        return f"{Path(path).name}:{line}, a line the file does not have ({count} lines)"
     if not named:
         return ""
-    name = named["name"]
-
-    def holds(text: str) -> bool:  # a mesh by its file name; a link or joint as a quoted attribute value
-        if named["kind"] in ("mesh", "extension"):
-            return Path(name).name in text
-        return f'"{name}"' in text or f"'{name}'" in text
-
-    if holds(lines[line - 1]):
+    name, kind = named["name"], named["kind"]
+    elements = [e for e in root.iter() if isinstance(e.tag, str) and (e.sourceline or 0) <= line]
+    if not elements:
         return ""
-    for earlier in range(line - 1, max(-1, line - 200), -1):  # the <link>/<joint> the line is inside
-        if re.search(r"<(?:link|joint)\b", lines[earlier]):
-            if holds(lines[earlier]):
-                return ""
-            break
-    return f"{Path(path).name}:{line} does not hold {named.group(0)} (it reads {lines[line - 1].strip()[:60]!r})"
+    at = elements[-1]
+
+    def holds(element) -> bool:
+        values = element.attrib.values()
+        return any(name in v if kind in ("mesh", "extension") else name == v for v in values)
+
+    if any(holds(e) for e in at.iter() if isinstance(e.tag, str)) or any(holds(e) for e in at.iterancestors()):
+        return ""
+    reads = text.splitlines()[line - 1].decode("utf-8", "replace").strip()[:60]
+    return f"{Path(path).name}:{line} does not hold {named.group(0)} (it reads {reads!r})"
 
 
 def fk_precision_problem(document: dict, path: Path) -> str:
