@@ -17,24 +17,13 @@ import struct
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ar3cli.doctor.record import Check
 from ar3cli.sim.capture import capture_fds
 
 MIN_PYTHON = (3, 10)
 STEPS = 240
-
-
-@dataclass(frozen=True)
-class Check:
-    name: str
-    status: str
-    detail: str
-    hint: str = ""
-
-    def to_dict(self) -> dict[str, str]:
-        return asdict(self)
 
 
 def _version(distribution: str) -> str:
