@@ -104,3 +104,27 @@ def test_ci_runs_the_plain_install_stage_after_the_readme_command():
     assert 'bash -euo pipefail -c "$command"' in readme_stage
     assert "pip install" in plain_stage and "[test]" not in plain_stage
     assert ".ci/plain_install_smoke.py" in plain_stage and (REPO / ".ci" / "plain_install_smoke.py").is_file()
+
+
+def _smoke_module():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("plain_install_smoke", REPO / ".ci" / "plain_install_smoke.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_smoke_fixture_has_what_its_steps_need(tmp_path, cli):
+    """CI's plain-install stage depends on its fixture: a closed U-shaped STL whose hull is far larger
+    (fix-collision must decompose it), a .dae link without an inertial (fix-inertia must compute one)."""
+    import trimesh
+
+    smoke = _smoke_module()
+    robot = smoke.make_robot(tmp_path)
+    u = trimesh.load(str(tmp_path / "meshes" / "u.stl"))
+    assert u.is_watertight and u.convex_hull.volume / u.volume > 2
+    assert "<inertial>" not in smoke.link_text(robot, "cube_link")
+    assert str(tmp_path.resolve()) in robot.read_text()  # fix-mesh-paths has an absolute path to rewrite
+    result = cli("info", str(robot), "--format", "json")
+    assert result.code == 0, result.stderr
