@@ -24,7 +24,15 @@ internal error  exit 3, a traceback, exit 2 with no or a long message, invalid J
                 JSON, or any other exit code
 silent wrong    looks clean but is not: render wrote a PNG with no robot in it (or none at all),
                 fk-verify's JSON holds NaN or contradicts its exit code, lint's exit code
-                contradicts its findings, a --diff fixer reports a write
+                contradicts its findings, a --diff fixer reports a write; and (second looks, issue 30)
+                a fixer that changes values yet leaves lint findings of its own rules (it is run again
+                with --output into a folder of symlinks to the robot's, and lint-urdf compares the
+                original and the fixed copy; what the fixer lists as skipped is excused), a line number
+                that does not hold what the message names (a finding's line must hold, or be inside
+                the <link>/<joint> that holds, the link/joint/mesh it names; a FILE:LINE quoted in a
+                load error or a P001 message must be a line of the user's file), fk-verify calling
+                FAIL an error below float32 precision at the robot's reach (eps32 x the sum of joint
+                offsets and prismatic travels)
 timeout         still running after --timeout seconds (the process group is killed)
 
 Runs that leave anything in their TMPDIR are counted separately ("leftover temp").
@@ -35,6 +43,11 @@ Usage (inside the project's venv)::
     python benchmarks/sweep_real_robots.py --commands lint-urdf,fix-inertia,fix-continuous
     python benchmarks/sweep_real_robots.py --source erd --match ur5 --json runs.json
     python benchmarks/sweep_real_robots.py --help
+
+From a plain install (what a user gets; PYTHONPATH is dropped for the runs)::
+
+    python3 -m venv /tmp/plain && /tmp/plain/bin/pip install .
+    python benchmarks/sweep_real_robots.py --ar3cli /tmp/plain/bin/ar3cli
 
 Commands (``--commands``): lint-urdf, lint-urdf-sim, render, sample-collisions, fk-verify,
 fix-inertia, fix-continuous, fix-joints, fix-mesh-paths, fix-collision, info (with --torques),
@@ -54,8 +67,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import functools
 import json
 import os
+import re
 import shutil
 import signal
 import subprocess
@@ -271,12 +286,14 @@ class RunRecord:
 class Runner:
     """Runs ar3cli subprocesses, each in its own folder; kills what is still running on interrupt."""
 
-    def __init__(self, ar3cli: str, sweep_dir: Path, timeout: float) -> None:
+    def __init__(self, ar3cli: str, sweep_dir: Path, timeout: float, plain: bool = False) -> None:
         self.ar3cli = ar3cli
         self.sweep_dir = sweep_dir
         self.timeout = timeout
         self.env = {**os.environ, "AR3CLI_CACHE_DIR": str(sweep_dir / "ar3cli-cache")}
         self.env.pop("AR3CLI_DEBUG", None)  # tracebacks only where ar3cli prints them by itself
+        if plain:  # --ar3cli of another venv: its own installed code, not a checkout's sources
+            self.env.pop("PYTHONPATH", None)
         self._lock = threading.Lock()
         self._count = 0
         self._running: set[subprocess.Popen[bytes]] = set()
@@ -467,6 +484,186 @@ CHECKS: dict[str, Callable[[object, int, Path], str]] = {
 }
 
 
+# --------------------------------------------------------------------------------------------
+# Second looks: answers that sound sure and are wrong (issue 30)
+
+FLOAT32_EPS = 1.1920929e-07
+FIXERS = ("fix-inertia", "fix-continuous", "fix-joints", "fix-mesh-paths", "fix-collision")
+NAMED = re.compile(r"\b(?P<kind>link|joint|mesh|parent|child|extension)\s+'(?P<name>[^'$]+)'")
+"""A thing a message names: ``link 'base'``, ``joint 'j1'``, ``mesh 'x.stl'``, ``extension '.ply'`` (xacro
+``${...}`` names skipped). Links and joints are matched as quoted attribute values, the rest as text."""
+LOOKED = Counter()
+"""How many things each second look examined (for the report: a signal that never looked proves nothing)."""
+_LOOKED_LOCK = threading.Lock()
+
+
+def looked(what: str) -> None:
+    with _LOOKED_LOCK:
+        LOOKED[what] += 1
+
+
+QUOTED_LINE = re.compile(r"(?P<file>[^\s:'\"]+\.(?:urdf|URDF|xacro)):(?P<line>\d+):(?P<rest>[^\n]*)")
+"""A ``FILE:LINE:`` a message quotes (a load error, a P001 finding): it must be a line of the user's file."""
+
+
+def second_look(runner: Runner, command: Command, path: Path, outcome: Outcome, run_dir: Path) -> str:
+    """The silent-wrong signals a run's own checks cannot see; '' when none."""
+    document, _ = parse_json(outcome.stdout)
+    if command.key in ("lint-urdf", "lint-urdf-sim") and isinstance(document, dict):
+        for finding in document.get("findings") or []:
+            if isinstance(finding, dict) and not QUOTED_LINE.search(str(finding.get("message", ""))):
+                if NAMED.search(str(finding.get("message", ""))) and finding.get("line"):
+                    looked("finding lines checked against the name they quote")
+                problem = line_problem(finding.get("path"), finding.get("line"), str(finding.get("message", "")))
+                if problem:
+                    return f"{finding.get('rule')}: {problem}"
+    texts = [outcome.stderr] if outcome.returncode == 2 else []
+    if command.key in ("lint-urdf", "lint-urdf-sim") and isinstance(document, dict):
+        texts += [str(f.get("message", "")) for f in document.get("findings") or [] if isinstance(f, dict)]
+    for text in texts:
+        for quoted in QUOTED_LINE.finditer(text):
+            if Path(quoted["file"]).name == path.name:  # a line of "the robot file", as the user reads it
+                looked("FILE:LINE quotes in load errors and P001 checked")
+                problem = line_problem(str(path), int(quoted["line"]), quoted["rest"], need_name=False)
+                if problem:
+                    return f"quotes {problem}"
+    if command.key == "fk-verify" and isinstance(document, dict):
+        return fk_precision_problem(document, path)
+    if command.key in FIXERS and isinstance(document, dict):
+        return fixer_left_dirty(runner, command, path, document, run_dir)
+    return ""
+
+
+@functools.lru_cache(maxsize=16)
+def _parsed(path: str) -> tuple[bytes, object] | None:
+    """The robot file's bytes and lxml tree (each finding of a file looks at the same file)."""
+    from lxml import etree
+
+    try:
+        text = Path(path).read_bytes()
+        return text, etree.fromstring(text, etree.XMLParser(resolve_entities=False, no_network=True))
+    except (OSError, etree.XMLSyntaxError, ValueError):
+        return None
+
+
+def line_problem(path: object, line: object, message: str, need_name: bool = True) -> str:
+    """'' when line ``line`` of ``path`` is inside an element that holds the thing ``message`` names.
+
+    The element at a line is the last one whose start tag begins at or before it (a multi-line start
+    tag included); it holds the thing when an attribute of it, of an element inside it, or of an element
+    around it has that value (a link or joint name) or contains it (a mesh file name, an extension):
+    the ``<inertia>`` line of ``link 'a'`` holds it, a ``<transmission>`` holds the joint it drives.
+    Without a name only the line's existence is checked (``need_name=False``)."""
+    named = NAMED.search(message)
+    if not isinstance(path, str) or not isinstance(line, int) or line < 1 or path.endswith(".xacro"):
+        return ""
+    if not named and need_name:
+        return ""
+    parsed = _parsed(path)
+    if parsed is None:
+        return ""
+    text, root = parsed
+    count = text.count(b"\n") + (not text.endswith(b"\n"))
+    if line > count:
+        return f"{Path(path).name}:{line}, a line the file does not have ({count} lines)"
+    if not named:
+        return ""
+    name, kind = named["name"], named["kind"]
+    elements = [e for e in root.iter() if isinstance(e.tag, str) and (e.sourceline or 0) <= line]
+    if not elements:
+        return ""
+    at = elements[-1]
+
+    def holds(element) -> bool:
+        values = element.attrib.values()
+        return any(name in v if kind in ("mesh", "extension") else name == v for v in values)
+
+    if any(holds(e) for e in at.iter() if isinstance(e.tag, str)) or any(holds(e) for e in at.iterancestors()):
+        return ""
+    reads = text.splitlines()[line - 1].decode("utf-8", "replace").strip()[:60]
+    return f"{Path(path).name}:{line} does not hold {named.group(0)} (it reads {reads!r})"
+
+
+def fk_precision_problem(document: dict, path: Path) -> str:
+    """fk-verify calling FAIL an error below float32 precision at the robot's reach (eps32 x reach)."""
+    error = document.get("max_position_error_m")
+    if document.get("passed") is not False or not isinstance(error, (int, float)):
+        return ""
+    looked("fk-verify FAILs checked against float32 precision")
+    reach = robot_reach(path)
+    if reach and error < FLOAT32_EPS * reach:
+        return f"FAIL on {error:.3g} m, below float32 precision at {reach:.3g} m reach ({FLOAT32_EPS * reach:.3g} m)"
+    return ""
+
+
+def robot_reach(path: Path) -> float | None:
+    """An upper bound on any link's distance from the base: every joint offset plus every prismatic travel."""
+    from lxml import etree
+
+    if path.suffix.lower() == ".xacro":
+        return None
+    try:
+        root = etree.parse(str(path), etree.XMLParser(resolve_entities=False, no_network=True)).getroot()
+    except (OSError, etree.XMLSyntaxError):
+        return None
+    reach = 0.0
+    for joint in root.iter("joint"):
+        origin, limit = joint.find("origin"), joint.find("limit")
+        with contextlib.suppress(ValueError, TypeError):
+            if origin is not None:
+                reach += sum(float(v) ** 2 for v in (origin.get("xyz") or "0 0 0").split()) ** 0.5
+            if joint.get("type") == "prismatic" and limit is not None:
+                reach += max(abs(float(limit.get("lower", 0))), abs(float(limit.get("upper", 0))))
+    return reach
+
+
+def fixer_left_dirty(runner: Runner, command: Command, path: Path, document: dict, run_dir: Path) -> str:
+    """A fixer that changed values must leave no finding of its own rules behind, except those it says it skipped.
+
+    The fixer runs again with --output into a folder of symlinks to the robot's folder (so relative mesh
+    paths still resolve, and the robot's tree is not written), then lint-urdf runs on the original and
+    on the fixed copy: a finding whose ``fixed_by`` names this fixer, present before and after, on a
+    thing the fixer neither skipped nor noted, is a fix that did not fix."""
+    files = document.get("files") or []
+    if not files or not isinstance(files[0], dict) or not files[0].get("changed"):
+        return ""
+    looked(f"{command.key} runs that changed values, re-linted after the fix")
+    mirror = run_dir / "mirror"
+    mirror.mkdir(exist_ok=True)
+    for entry in path.parent.iterdir():
+        if entry.name != path.name:
+            with contextlib.suppress(OSError):
+                (mirror / entry.name).symlink_to(entry)
+    fixed = mirror / path.name
+    argv = [a for a in command.args(str(path), run_dir) if a not in ("--diff",)]
+    package = ["--package-path", collection_package(str(path))]
+    rerun = runner.run([*argv, "--output", str(fixed), *package], run_dir)
+    if rerun.returncode not in (0, 1) or not fixed.is_file():
+        return ""
+    options = set(argv)
+
+    def own(target: Path) -> set[tuple[str, str]]:
+        outcome = runner.run(["lint-urdf", str(target), "--no-cache", "--no-config", "--format", "json", *package],
+                             run_dir)
+        lint, _ = parse_json(outcome.stdout)
+        findings = lint.get("findings", []) if isinstance(lint, dict) else []
+        result = set()
+        for finding in findings:
+            words = str(finding.get("fixed_by") or "").split()
+            if words[:1] == [command.key] and all(w in options for w in words[1:] if w.startswith("--")):
+                named = NAMED.search(str(finding.get("message", "")))
+                result.add((str(finding.get("rule")), named["name"] if named else str(finding.get("message"))))
+        return result
+
+    left = own(path) & own(fixed)
+    excused = json.dumps([files[0].get("skipped"), files[0].get("notes")])
+    left = {(rule, name) for rule, name in left if name not in excused}
+    if left:
+        rule, name = sorted(left)[0]
+        return f"changed values but left {len(left)} of its own finding(s), e.g. {rule} on {name!r}"
+    return ""
+
+
 def execute(runner: Runner, command: Command, robot: Robot | None) -> RunRecord:
     """Run ``command`` on ``robot`` (None: a command without a file) and classify it."""
     run_dir = runner.new_run_dir()
@@ -474,6 +671,10 @@ def execute(runner: Runner, command: Command, robot: Robot | None) -> RunRecord:
         argv = command.args(str(robot.path) if robot else "", run_dir)
         outcome = runner.run(argv, run_dir)
         verdict, reason = classify(command, outcome, run_dir)
+        if verdict in ("clean", "user error") and robot is not None:
+            problem = second_look(runner, command, robot.path, outcome, run_dir)
+            if problem:
+                verdict, reason = "silent wrong", problem
     finally:
         shutil.rmtree(run_dir, ignore_errors=True)
     return RunRecord(
@@ -549,6 +750,8 @@ def report(records: list[RunRecord], commands: list[Command], changes: list[str]
            or "(none)"),
         f"\n### Robot files changed by the sweep ({len(changes)})\n\n"
         + ("\n".join(f"- {c}" for c in changes) or "(none)"),
+        "\n### Second looks (what the silent-wrong signals examined)\n\n"
+        + ("\n".join(f"- {what}: {count}" for what, count in sorted(LOOKED.items())) or "(nothing to examine)"),
         f"\nTotal wall time: {wall:.1f} s",
     ]
     return "\n".join(parts)
@@ -575,7 +778,9 @@ def parse_args(argv: list[str] | None = None) -> argparse.Namespace:
     parser.add_argument("--jobs", "-j", type=int, default=2, help="subprocesses at once (default: 2)")
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds per run (default: 300)")
     parser.add_argument("--json", type=Path, metavar="FILE", help="write every run's record to FILE")
-    parser.add_argument("--ar3cli", metavar="PATH", help="the ar3cli executable (default: from PATH)")
+    parser.add_argument("--ar3cli", metavar="PATH",
+                        help="the ar3cli executable (default: from PATH); given, it runs without PYTHONPATH, so "
+                             "VENV/bin/ar3cli of a plain `pip install .` sweeps exactly what a user installs")
     args = parser.parse_args(argv)
     if args.jobs < 1 or (args.limit is not None and args.limit < 1) or args.timeout <= 0:
         parser.error("--jobs, --limit and --timeout must be positive")
@@ -619,7 +824,7 @@ def main(argv: list[str] | None = None) -> int:
     sweep_dir = Path(tempfile.mkdtemp(prefix="sweep-real-robots-"))
     start = time.perf_counter()
     try:
-        records = sweep(Runner(ar3cli, sweep_dir, args.timeout), robots, commands, args.jobs)
+        records = sweep(Runner(ar3cli, sweep_dir, args.timeout, plain=bool(args.ar3cli)), robots, commands, args.jobs)
     finally:
         shutil.rmtree(sweep_dir, ignore_errors=True)
     wall = time.perf_counter() - start

@@ -17,24 +17,13 @@ import struct
 import sys
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from ar3cli.doctor.record import Check
 from ar3cli.sim.capture import capture_fds
 
 MIN_PYTHON = (3, 10)
 STEPS = 240
-
-
-@dataclass(frozen=True)
-class Check:
-    name: str
-    status: str
-    detail: str
-    hint: str = ""
-
-    def to_dict(self) -> dict[str, str]:
-        return asdict(self)
 
 
 def _version(distribution: str) -> str:
@@ -206,13 +195,18 @@ CHECKS: list[Callable[[], Check]] = [
 
 
 def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
-    """Run every check, each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside one
+    """Run ``checks`` (default: :data:`CHECKS`, then one per capability of
+    :mod:`ar3cli.doctor.capabilities`), each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside one
     becomes a ``fail`` for that check only, and so does a crash of pybullet's C code (a broken
     build), which would otherwise end install-check with no report at all."""
     from ar3cli.infra.isolation import CrashError, run_isolated
 
+    if checks is None:
+        from ar3cli.doctor.capabilities import CAPABILITY_CHECKS
+
+        checks = [*CHECKS, *CAPABILITY_CHECKS]
     results = []
-    for check in checks or CHECKS:
+    for check in checks:
         name = check.__name__.removeprefix("check_")
         try:
             result = run_isolated(functools.partial(_run_one, check), f"install-check {name}")
@@ -222,6 +216,8 @@ def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
         results.append(result)
         if result.name == "pybullet" and result.status == "ok":
             import_pybullet_here()
+        if result.name == "trimesh" and result.status == "ok":
+            import trimesh  # noqa: F401 - the capability checks' children inherit it (~0.5 s each otherwise)
     return results
 
 

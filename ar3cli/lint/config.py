@@ -12,7 +12,7 @@ Recognised keys (all optional)::
     J008 = "error"
 
 A typo in a key or a code is a usage error (exit 2), not silently ignored. Python 3.10 has no
-``tomllib``; there the configuration is skipped with a warning on stderr.
+``tomllib``; there ``tomli`` (the same parser, a dependency on 3.10 only) reads it.
 """
 
 from __future__ import annotations
@@ -51,8 +51,6 @@ def find_pyproject(start: Path) -> Path | None:
 def load_config(start: Path | None = None) -> LintConfig:
     """Read and validate ``[tool.ar3cli.lint]``; raises UserError (exit 2) on a bad configuration."""
     from ar3cli.lint.rules import REGISTRY, validate_patterns
-    from ar3cli.output.report import log
-
     path = find_pyproject((start or Path.cwd()).resolve())
     if path is None:
         return LintConfig()
@@ -64,9 +62,8 @@ def load_config(start: Path | None = None) -> LintConfig:
         return LintConfig(path)
     try:
         import tomllib
-    except ModuleNotFoundError:  # Python 3.10
-        log(f"ar3cli: warning: {path}: Python 3.10 has no tomllib; [tool.ar3cli.lint] is ignored")
-        return LintConfig(path)
+    except ModuleNotFoundError:  # Python 3.10: tomli, a declared dependency there, is the same parser
+        import tomli as tomllib
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
