@@ -34,7 +34,8 @@ SHAPES = ("chain", "star")
 
 def robot(shape: str, links: int) -> str:
     """A URDF of ``links`` links, each one's parent the previous link (chain) or the root (star)."""
-    lines = ['<?xml version="1.0"?>', '<robot name="growth">', '<material name="grey"><color rgba="0.5 0.5 0.5 1"/></material>',
+    lines = ['<?xml version="1.0"?>', '<robot name="growth">',
+             '<material name="grey"><color rgba="0.5 0.5 0.5 1"/></material>',
              '<link name="l0"><visual><geometry><box size="0.2 0.2 0.2"/></geometry></visual></link>']
     for index in range(1, links):
         parent = f"l{index - 1}" if shape == "chain" else "l0"

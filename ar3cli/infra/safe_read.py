@@ -22,15 +22,17 @@ ROBOT_FILE = "a .urdf or .xacro file"
 """What :func:`read_bytes` expects unless told otherwise (the wording of its messages)."""
 
 
-def read_bytes(path: Path, *, limit: int = MAX_FILE_BYTES, what: str = ROBOT_FILE) -> bytes:
+def read_bytes(path: Path, *, limit: int | None = None, what: str = ROBOT_FILE) -> bytes:
     """Return the file's bytes, or raise a one-line :class:`UserError` saying why not.
 
-    ``limit`` is the largest size accepted, in bytes; ``what`` says what the file should be, with
-    its article ("a YAML file", "a mesh"), for the messages. The file is opened without blocking
+    ``limit`` is the largest size accepted, in bytes (:data:`MAX_FILE_BYTES` when not given); ``what``
+    says what the file should be, with its article ("a YAML file", "a mesh"), for the messages.
+    The file is opened without blocking
     and checked on the open descriptor: a FIFO, a device or a terminal (which would wait forever or
     never end) is refused even if it replaced a regular file a moment ago, and at most ``limit`` + 1
     bytes are read, so a file growing while it is read cannot exceed the limit either.
     """
+    limit = MAX_FILE_BYTES if limit is None else limit
     with _open_regular(path, what) as handle:
         size = os.fstat(handle.fileno()).st_size
         if size > limit:
@@ -76,12 +78,10 @@ def _open_regular(path: Path, what: str):
         raise UserError(f"{path}: is a directory, expected {what}") from None
     except OSError as exc:
         raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    handle = os.fdopen(descriptor, "rb")
     mode = os.fstat(descriptor).st_mode
-    if stat.S_ISDIR(mode):
-        handle.close()
-        raise UserError(f"{path}: is a directory, expected {what}")
     if not stat.S_ISREG(mode):
-        handle.close()
+        os.close(descriptor)
+        if stat.S_ISDIR(mode):
+            raise UserError(f"{path}: is a directory, expected {what}")
         raise UserError(f"{path}: not a regular file (a pipe, socket or device); expected {what}")
-    return handle
+    return os.fdopen(descriptor, "rb")
