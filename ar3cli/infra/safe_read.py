@@ -65,7 +65,9 @@ def _plural(what: str) -> str:
     if what == ROBOT_FILE:
         return "robot descriptions"
     noun = what.split(" ", 1)[1] if what.startswith(("a ", "an ")) else what
-    return noun if noun.endswith("s") else noun + "s"
+    if noun.endswith("s"):
+        return noun
+    return noun + ("es" if noun.endswith(("sh", "ch", "x")) else "s")
 
 
 def _open_regular(path: Path, what: str):
