@@ -89,8 +89,9 @@ def mesh_loadable(path: Path) -> bool:
 def leave_out_unloadable_mesh(mesh_element, path: Path) -> bool:
     """Remove the ``<visual>`` or ``<collision>`` holding ``mesh_element`` when the mesh at ``path`` may not be
     loaded (:func:`mesh_loadable`): pybullet is never handed a mesh over the cap, nor a FIFO it would block
-    on. Used on the copy pybullet loads, never on the user's file; True when it was left out."""
-    if mesh_loadable(path):
+    on. Used on the copy pybullet loads, never on the user's file; True when it was left out. Any other
+    element with a ``filename`` (a ``<texture>``) is left alone."""
+    if mesh_element.tag != "mesh" or mesh_loadable(path):
         return False
     shape = mesh_element.getparent()  # <geometry>
     shape = shape.getparent() if shape is not None else None  # <visual> or <collision>
