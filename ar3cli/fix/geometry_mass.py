@@ -113,10 +113,19 @@ def mesh_mass(shape: Shape, cache: dict) -> tuple[mp.MassProperties, str]:
 def load_welded_mesh(path: Path):
     """The trimesh mesh of ``path`` with its vertices welded by position (OBJ files split them by
     texture coordinate and normal); GeometryError when it cannot be read or has no triangle."""
+    import io
+
     import trimesh
 
+    from ar3cli.errors import UserError
+    from ar3cli.urdf.meshinfo import read_mesh
+
+    try:  # the capped, non-blocking reader: never a FIFO, never a multi-GB mesh
+        data = read_mesh(path)
+    except UserError as exc:
+        raise GeometryError(f"mesh {path.name}: {exc.message.removeprefix(f'{path}: ')}") from None
     try:
-        mesh = trimesh.load(str(path), force="mesh", process=True)
+        mesh = trimesh.load(io.BytesIO(data), file_type=path.suffix.lower().lstrip("."), force="mesh", process=True)
     except Exception as exc:  # noqa: BLE001 - trimesh raises many types for unreadable files
         raise GeometryError(f"mesh {path.name}: cannot read: {exc}") from None
     if mesh is None or len(getattr(mesh, "faces", ())) == 0:

@@ -1,7 +1,10 @@
 """Read a file that may be anything a user passes (a FIFO, a device, a huge file) without hanging.
 
-Robot files and the on-disk caches are read through :func:`read_bytes`: opened without blocking,
-checked on the open descriptor, size-capped; every problem is a one-line UserError.
+Every file ar3cli reads is read here: robot files and xacro includes, YAML inputs, ``package.xml``,
+SRDF, meshes, and the on-disk caches. :func:`read_bytes` opens without blocking, checks the open
+descriptor (a regular file, not larger than the caller's limit), and never reads more than the
+limit even when the file grows meanwhile; :func:`read_head` reads only a file's first bytes the same
+way. Every problem is a one-line :class:`UserError`.
 """
 
 from __future__ import annotations
@@ -15,33 +18,72 @@ from ar3cli.errors import UserError
 MAX_FILE_BYTES = 50 * 1024 * 1024
 """Files larger than this are refused: no real URDF comes close (the largest in pybullet_data is ~1 MB)."""
 
+ROBOT_FILE = "a .urdf or .xacro file"
+"""What :func:`read_bytes` expects unless told otherwise (the wording of its messages)."""
 
-def read_bytes(path: Path) -> bytes:
+
+def read_bytes(path: Path, *, limit: int | None = None, what: str = ROBOT_FILE) -> bytes:
     """Return the file's bytes, or raise a one-line :class:`UserError` saying why not.
 
-    The file is opened without blocking and checked on the open descriptor: a FIFO or a terminal
-    (which would wait forever) is refused even if it replaced a regular file a moment ago.
+    ``limit`` is the largest size accepted, in bytes (:data:`MAX_FILE_BYTES` when not given); ``what``
+    says what the file should be, with its article ("a YAML file", "a mesh"), for the messages.
+    The file is opened without blocking
+    and checked on the open descriptor: a FIFO, a device or a terminal (which would wait forever or
+    never end) is refused even if it replaced a regular file a moment ago, and at most ``limit`` + 1
+    bytes are read, so a file growing while it is read cannot exceed the limit either.
     """
-    if not path.exists():
-        raise UserError(f"{path}: no such file")
-    if path.is_dir():
-        raise UserError(f"{path}: is a directory, expected a .urdf or .xacro file")
-    try:
-        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
-    except OSError as exc:
-        raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
-    with os.fdopen(descriptor, "rb") as handle:
-        status = os.fstat(descriptor)
-        if not stat.S_ISREG(status.st_mode):
-            raise UserError(f"{path}: not a regular file (a pipe, socket or device); expected a .urdf or .xacro file")
-        if status.st_size > MAX_FILE_BYTES:
-            raise UserError(
-                f"{path}: file is {status.st_size / 1e6:.0f} MB, larger than the {MAX_FILE_BYTES // 1024 // 1024} MB "
-                "limit for robot descriptions; is this really a URDF?"
-            )
+    limit = MAX_FILE_BYTES if limit is None else limit
+    with _open_regular(path, what) as handle:
+        size = os.fstat(handle.fileno()).st_size
+        if size > limit:
+            raise UserError(too_large(path, size, limit, what))
         try:
-            return handle.read()
+            data = handle.read(limit + 1)
+        except OSError as exc:
+            raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    if len(data) > limit:
+        raise UserError(too_large(path, len(data), limit, what))
+    return data
+
+
+def read_head(path: Path, count: int, *, what: str = "a file") -> bytes:
+    """The first ``count`` bytes of a regular file (fewer if it is shorter); UserError as :func:`read_bytes`."""
+    with _open_regular(path, what) as handle:
+        try:
+            return handle.read(count)
         except OSError as exc:
             raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
 
 
+def too_large(path: Path, size: int, limit: int, what: str) -> str:
+    """The message for a file over its limit: its size and the limit in MB, and what it should be."""
+    return (f"{path}: file is {size / 1e6:.0f} MB, larger than the {limit / 1024 / 1024:g} MB limit for "
+            f"{_plural(what)}; is this really {what}?")
+
+
+def _plural(what: str) -> str:
+    if what == ROBOT_FILE:
+        return "robot descriptions"
+    noun = what.split(" ", 1)[1] if what.startswith(("a ", "an ")) else what
+    if noun.endswith("s"):
+        return noun
+    return noun + ("es" if noun.endswith(("sh", "ch", "x")) else "s")
+
+
+def _open_regular(path: Path, what: str):
+    """An open binary handle on ``path``, checked to be a regular file (opened without blocking)."""
+    try:
+        descriptor = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_NOCTTY", 0))
+    except FileNotFoundError:
+        raise UserError(f"{path}: no such file") from None
+    except IsADirectoryError:
+        raise UserError(f"{path}: is a directory, expected {what}") from None
+    except OSError as exc:
+        raise UserError(f"{path}: cannot read: {exc.strerror or exc}") from exc
+    mode = os.fstat(descriptor).st_mode
+    if not stat.S_ISREG(mode):
+        os.close(descriptor)
+        if stat.S_ISDIR(mode):
+            raise UserError(f"{path}: is a directory, expected {what}")
+        raise UserError(f"{path}: not a regular file (a pipe, socket or device); expected {what}")
+    return os.fdopen(descriptor, "rb")

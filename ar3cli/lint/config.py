@@ -54,9 +54,11 @@ def load_config(start: Path | None = None) -> LintConfig:
     path = find_pyproject((start or Path.cwd()).resolve())
     if path is None:
         return LintConfig()
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
+    from ar3cli.infra.safe_read import read_bytes
+
+    try:  # capped and non-blocking, like every file ar3cli reads (the 50 MB default cap: pyprojects are KB)
+        text = read_bytes(path, what="a pyproject.toml").decode("utf-8")
+    except UnicodeDecodeError as exc:
         raise UserError(f"{path}: cannot read configuration: {exc}") from None
     if "ar3cli" not in text:  # another tool's pyproject: no need to parse it (or import tomllib)
         return LintConfig(path)
@@ -68,6 +70,8 @@ def load_config(start: Path | None = None) -> LintConfig:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise UserError(f"{path}: cannot read configuration: {exc}") from None
+    except RecursionError:  # tomllib parses nested arrays recursively: 100,000 brackets are bad input, not a bug
+        raise UserError(f"{path}: cannot read configuration: nested too deeply") from None
     table: dict[str, Any] = data.get("tool", {}).get("ar3cli", {}).get("lint", {})
     if not isinstance(table, dict):
         raise UserError(f"{path}: [tool.ar3cli.lint] must be a table")

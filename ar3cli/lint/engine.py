@@ -363,17 +363,45 @@ def _codes(text: str | None) -> list[str]:
 
 
 def suppressed_inline(element, code: str) -> bool:
-    """True when the element or an ancestor holds a ``<!-- ar3cli: ignore[...] -->`` child comment."""
-    from lxml import etree
+    """True when the element or an ancestor holds a ``<!-- ar3cli: ignore[...] -->`` child comment.
 
-    node = element
-    while node is not None:
-        for child in node.iterchildren(etree.Comment):
-            match = _INLINE.search(child.text or "")
-            if match and matches(code, _codes(match.group(1))):
+    The ignore comments of the element's tree are gathered once (:class:`InlineIgnores`, kept for the
+    last tree asked about), so each question walks only the element's ancestors: the 20,000 siblings
+    of a star robot's root are not read again for every finding.
+    """
+    global _LAST_IGNORES
+    root = element.getroottree().getroot()
+    if _LAST_IGNORES is None or _LAST_IGNORES.root is not root:
+        _LAST_IGNORES = InlineIgnores(root)
+    return _LAST_IGNORES.suppresses(element, code)
+
+
+class InlineIgnores:
+    """The ``<!-- ar3cli: ignore[...] -->`` comments of one tree: element -> codes its comment children list."""
+
+    def __init__(self, root) -> None:
+        from lxml import etree
+
+        self.root = root
+        """Held so the tree (and the identity of its elements) lives as long as this index."""
+        self.codes: dict[Any, list[str]] = {}
+        for comment in root.iter(etree.Comment):
+            match = _INLINE.search(comment.text or "")
+            parent = comment.getparent()
+            if match and parent is not None:
+                self.codes.setdefault(parent, []).extend(_codes(match.group(1)))
+
+    def suppresses(self, element, code: str) -> bool:
+        node = element
+        while node is not None:
+            codes = self.codes.get(node)
+            if codes is not None and matches(code, codes):
                 return True
-        node = node.getparent()
-    return False
+            node = node.getparent()
+        return False
+
+
+_LAST_IGNORES: InlineIgnores | None = None
 
 
 def _override(finding: Finding, options: LintOptions) -> Finding:

@@ -35,6 +35,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, NamedTuple
 
+from ar3cli.urdf.meshinfo import leave_out_unloadable_mesh
 from ar3cli.urdf.model import Model, read_quaternion
 
 UNNAMED_ROBOT = "robot"
@@ -71,13 +72,14 @@ def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None 
     _order_links_parent_first(root, ((joint.parent, joint.child) for joint in model.joints))
     _quaternions_as_rpy(root)
     etree.indent(root, space=" ")
-    for element in root.iter():
+    for element in list(root.iter()):
         uri = element.get("filename")
         if not uri:
             continue
         resolution = model.resolver.resolve(uri)
         if resolution.found:
             element.set("filename", str(resolution.path))
+            leave_out_unloadable_mesh(element, resolution.path)  # over the mesh cap, or a FIFO: lint's G011
     document = etree.tostring(root, xml_declaration=True, encoding="utf-8")
     if lines is not None:
         lines.update(line_map(model, root, document))

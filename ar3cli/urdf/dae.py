@@ -62,10 +62,14 @@ def _node_matrix(node) -> np.ndarray:
             raise Unsupported(kind)
     return matrix
 
-def dae_bounds(path: Path) -> Bounds | None:
+def dae_bounds(path: Path, data: bytes | None = None) -> Bounds | None:
     """(min corner, max corner) in file units; None when the scene holds no finite vertex."""
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=True, remove_comments=True)
-    root = etree.parse(str(path), parser).getroot()
+    if data is None:
+        from ar3cli.infra.safe_read import read_bytes
+
+        data = read_bytes(path, what="a mesh")  # never a FIFO; meshinfo passes the bytes it read under its cap
+    root = etree.fromstring(data, parser)
     by_id = {el.get("id"): el for el in root.iter() if el.get("id")}
     positions = {}
     def source_points(source_id: str) -> np.ndarray:

@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import stat as stat_module
 import struct
 import sys
 from array import array
@@ -22,12 +23,23 @@ from collections.abc import Sequence
 from functools import lru_cache
 from pathlib import Path
 
+from ar3cli.errors import UserError
 from ar3cli.infra.file_cache import MISSING, file_facts
+from ar3cli.infra.safe_read import read_bytes, read_head, too_large
 
 LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 LFS_POINTER_MAX_BYTES = 1024
 """Git LFS's specification: "Pointer files must be less than 1024 bytes in size"."""
-MAX_MESH_BYTES = 200 * 1024 * 1024
+MAX_MESH_BYTES = 64 * 1024 * 1024
+"""The mesh cap: a larger mesh is not read (G011 reports it; ``--sim`` leaves it out of what pybullet
+loads), so no mesh can make ar3cli use gigabytes (a 199 MB OBJ took 6 GB with no cap). Chosen from
+real data: the largest of the 1,992 STL/OBJ/DAE meshes of example-robot-data and pybullet_data is
+go1's trunk.dae, 28.8 MB (then b1's trunk.dae 24.3 MB, pybullet_data's samurai_monastry.obj 10 MB);
+64 MB is twice that with margin. Reading a mesh at the cap takes at most a few hundred MB: text
+formats are parsed in :data:`TEXT_CHUNK_BYTES` pieces."""
+TEXT_CHUNK_BYTES = 4 * 1024 * 1024
+"""OBJ and ASCII STL vertices are boxed piece by piece (split at line ends): Python floats and tokens
+take ~30 bytes of memory per byte of text, so a whole 64 MB OBJ at once would take ~2 GB."""
 NUMPY_MIN_BYTES = 16 * 1024 * 1024
 """Binary STL size from which numpy is faster, import included (measured: plain Python ~7 ms/MB,
 numpy ~3 ms/MB plus ~0.1 s to import it)."""
@@ -46,6 +58,48 @@ _STL_RECORD = 50
 _DISK_CACHE = file_facts("mesh-bounds", version=2)
 
 
+def read_mesh(path: Path) -> bytes:
+    """The bytes of a mesh file: a regular file of at most :data:`MAX_MESH_BYTES` (UserError otherwise)."""
+    return read_bytes(path, limit=MAX_MESH_BYTES, what="a mesh")
+
+
+def mesh_refusal(path: Path) -> str | None:
+    """Why ar3cli will not read (nor hand pybullet) the mesh at ``path``: over the cap, or not a
+    regular file (a FIFO would block the reader, a device never end); None when it may be loaded.
+
+    One ``stat``; :func:`ar3cli.sim.loadable_copy.loadable_document` asks it for every mesh it hands
+    to pybullet, :func:`mesh_content` (G011) for every mesh a lint reads.
+    """
+    try:
+        status = os.stat(path)
+    except OSError as exc:
+        return f"{path}: cannot read: {exc.strerror or exc}"
+    if not stat_module.S_ISREG(status.st_mode):
+        return f"{path}: not a regular file (a pipe, socket or device); expected a mesh"
+    if status.st_size > MAX_MESH_BYTES:
+        return too_large(path, status.st_size, MAX_MESH_BYTES, "a mesh")
+    return None
+
+
+def mesh_loadable(path: Path) -> bool:
+    """True when the mesh at ``path`` is a regular file within :data:`MAX_MESH_BYTES` (see :func:`mesh_refusal`)."""
+    return mesh_refusal(path) is None
+
+
+def leave_out_unloadable_mesh(mesh_element, path: Path) -> bool:
+    """Remove the ``<visual>`` or ``<collision>`` holding ``mesh_element`` when the mesh at ``path`` may not be
+    loaded (:func:`mesh_loadable`): pybullet is never handed a mesh over the cap, nor a FIFO it would block
+    on. Used on the copy pybullet loads, never on the user's file; True when it was left out. Any other
+    element with a ``filename`` (a ``<texture>``) is left alone."""
+    if mesh_element.tag != "mesh" or mesh_loadable(path):
+        return False
+    shape = mesh_element.getparent()  # <geometry>
+    shape = shape.getparent() if shape is not None else None  # <visual> or <collision>
+    if shape is not None and shape.getparent() is not None:
+        shape.getparent().remove(shape)
+    return True
+
+
 def is_lfs_pointer(path: Path) -> bool:
     """True when ``path`` is a Git LFS pointer (the mesh was never pulled: ``git lfs pull``).
 
@@ -55,9 +109,8 @@ def is_lfs_pointer(path: Path) -> bool:
     try:
         if os.stat(path).st_size >= LFS_POINTER_MAX_BYTES:
             return False
-        with path.open("rb") as handle:
-            return handle.read(len(LFS_POINTER_PREFIX)) == LFS_POINTER_PREFIX
-    except OSError:
+        return read_head(path, len(LFS_POINTER_PREFIX), what="a mesh") == LFS_POINTER_PREFIX
+    except (OSError, UserError):
         return False
 
 
@@ -93,12 +146,15 @@ def _mesh_bounds(path: Path, _mtime_ns: int, size: int) -> Bounds | None:
             return None
         suffix = path.suffix.lower()
         if suffix == ".stl":
-            data = path.read_bytes()
-            if _binary_stl_count(data) is not None and size >= NUMPY_MIN_BYTES:
-                return _numpy_stl_bounds(data)
-            parsed = _stl_columns(data)
+            data = read_mesh(path)
+            if _binary_stl_count(data) is not None:
+                if size >= NUMPY_MIN_BYTES:
+                    return _numpy_stl_bounds(data)
+                parsed = _stl_columns(data)
+            else:
+                return _text_bounds(data, _stl_text_columns)
         elif suffix == ".obj":
-            parsed = _obj_columns(path.read_bytes())
+            return _text_bounds(read_mesh(path), _obj_columns)
         elif suffix == ".dae":
             return _dae_bounds(path)
         else:
@@ -106,6 +162,30 @@ def _mesh_bounds(path: Path, _mtime_ns: int, size: int) -> Bounds | None:
     except Exception:  # noqa: BLE001 - a mesh we cannot read is the loader's problem, not a reason to crash the lint
         return None
     return _bounds(*parsed) if parsed is not None else None
+
+
+def _text_bounds(data: bytes, columns) -> Bounds | None:
+    """Box of a text mesh's vertices, parsed :data:`TEXT_CHUNK_BYTES` at a time (memory bounded).
+
+    Pieces end at a line end, and every vertex is on one line, so each vertex is in one piece.
+    """
+    low: list[float] | None = None
+    high: list[float] | None = None
+    start = 0
+    while start < len(data):
+        end = len(data) if len(data) - start <= TEXT_CHUNK_BYTES else data.find(b"\n", start + TEXT_CHUNK_BYTES)
+        end = len(data) if end < 0 else end + 1
+        # Each piece starts with a newline, as the vertex patterns expect before a statement.
+        parsed = columns(b"\n" + data[start:end])
+        start = end
+        box = _bounds(*parsed) if parsed is not None else None
+        if box is None:
+            continue
+        low = list(box[0]) if low is None else [min(a, b) for a, b in zip(low, box[0])]
+        high = list(box[1]) if high is None else [max(a, b) for a, b in zip(high, box[1])]
+    if low is None or high is None:
+        return None
+    return (low[0], low[1], low[2]), (high[0], high[1], high[2])
 
 
 def _bounds(columns: Columns, may_be_nonfinite: bool) -> Bounds | None:
@@ -136,8 +216,7 @@ def _binary_stl_count(data: bytes) -> int | None:
 def _stl_columns(data: bytes) -> tuple[Columns, bool] | None:
     count = _binary_stl_count(data)
     if count is None:
-        tokens = [v for match in _STL_VERTEX.findall(data) for v in match]
-        return _text_columns(tokens, b" ".join(tokens))
+        return _stl_text_columns(data)
     # Gather the 36 vertex bytes of each 50-byte record with strided copies of 16-bit words
     # (records are 2-byte aligned), then read them as float32: no per-triangle Python code.
     words = array("H", data[84:])
@@ -152,6 +231,12 @@ def _stl_columns(data: bytes) -> tuple[Columns, bool] | None:
     high_bytes = raw[3::4]
     may_be_nonfinite = b"\x7f" in high_bytes or b"\xff" in high_bytes
     return (flat[0::3], flat[1::3], flat[2::3]), may_be_nonfinite
+
+
+def _stl_text_columns(data: bytes) -> tuple[Columns, bool]:
+    """The vertices of an ASCII STL (or of a piece of one)."""
+    tokens = [v for match in _STL_VERTEX.findall(data) for v in match]
+    return _text_columns(tokens, b" ".join(tokens))
 
 
 def _obj_columns(data: bytes) -> tuple[Columns, bool] | None:
@@ -192,8 +277,9 @@ def _dae_bounds(path: Path) -> Bounds | None:
     """COLLADA bounds by :mod:`ar3cli.urdf.dae` (3x faster), trimesh where that reader gives up."""
     from ar3cli.urdf.dae import dae_bounds
 
+    data = read_mesh(path)
     try:
-        return dae_bounds(path)
+        return dae_bounds(path, data)
     except Exception:  # noqa: BLE001 - Unsupported, or a file it cannot parse: trimesh has its own say
         return _trimesh_bounds(path)
 
@@ -206,11 +292,13 @@ def _trimesh_bounds(path: Path) -> Bounds | None:
     vertices never become Python lists (on 40 example-robot-data robots, boxing trimesh's vertices
     in Python took 10 of the 20 s of a cold lint).
     """
+    import io
+
     import numpy as np
     import trimesh
 
-    with path.open("rb") as handle:
-        loaded = trimesh.load(handle, file_type=path.suffix.lower().lstrip("."), force="mesh", process=False)
+    loaded = trimesh.load(io.BytesIO(read_mesh(path)), file_type=path.suffix.lower().lstrip("."), force="mesh",
+                          process=False)
     vertices = np.asarray(getattr(loaded, "vertices", ()), dtype=float).reshape(-1, 3)
     vertices = vertices[np.isfinite(vertices).all(axis=1)]
     if len(vertices) == 0:
@@ -242,7 +330,7 @@ mesh is 137 KB (link6.obj), so a lint of it still imports no numpy (tests/test_l
 _MERGE_GRID = 2 ** 20
 """Vertices closer than 1/_MERGE_GRID of the mesh's bounding-box diagonal are one (21 bits a coordinate)."""
 
-_CONTENT_CACHE = file_facts("mesh-content", version=2)
+_CONTENT_CACHE = file_facts("mesh-content", version=3)
 _HULL_CACHE = file_facts("mesh-hull", version=2)
 
 
@@ -255,9 +343,8 @@ def collada_unit(path: Path) -> float | None:
     :func:`mesh_bounds` uses for COLLADA, does not.
     """
     try:
-        with path.open("rb") as handle:
-            head = handle.read(COLLADA_HEAD_BYTES)
-    except OSError:
+        head = read_head(path, COLLADA_HEAD_BYTES, what="a mesh")
+    except (OSError, UserError):
         return None
     match = _COLLADA_UNIT.search(head)
     if match is None:
@@ -275,10 +362,11 @@ def mesh_content(path: Path) -> tuple[str, int | None, int | None] | None:
     ``kind`` is ``stl-binary`` (its size is 84 + 50 x the triangle count in its header),
     ``stl-ascii`` (starts with ``solid`` and names a ``facet``, size not binary),
     ``stl-broken`` (neither: truncated or not an STL at all), ``obj``, or ``other`` (a format
-    this function does not look into). ``faces`` is the triangle count of a binary STL (from the
+    this function does not look into), ``too-large`` (over :data:`MAX_MESH_BYTES`: not read) or
+    ``not-a-file`` (a FIFO, socket or device: not read). ``faces`` is the triangle count of a binary STL (from the
     header, free) or the number of ``f`` lines of an OBJ; ``groups`` the number of blocks of faces
     an OBJ's ``o``/``g`` statements separate (tinyobjloader, which PyBullet uses, makes a shape of
-    each). None when the file cannot be read, is too large or is a Git LFS pointer.
+    each). None when the file cannot be read or is a Git LFS pointer.
     Cached per file version on disk like :func:`mesh_bounds` (an OBJ is read whole once).
     """
     try:
@@ -288,19 +376,22 @@ def mesh_content(path: Path) -> tuple[str, int | None, int | None] | None:
     stored = _CONTENT_CACHE.get(path, stat)
     if stored is not MISSING and (stored is None or (isinstance(stored, list) and len(stored) == 3)):
         return tuple(stored) if stored is not None else None  # type: ignore[return-value]
-    content = _mesh_content(path, stat.st_size)
+    content = _mesh_content(path, stat.st_size, stat.st_mode)
     _CONTENT_CACHE.put(path, stat, list(content) if content is not None else None)
     return content
 
 
-def _mesh_content(path: Path, size: int) -> tuple[str, int | None, int | None] | None:
+def _mesh_content(path: Path, size: int, mode: int) -> tuple[str, int | None, int | None] | None:
+    if not stat_module.S_ISREG(mode):
+        return "not-a-file", None, None
+    if size > MAX_MESH_BYTES:
+        return "too-large", None, None
     try:
-        if size > MAX_MESH_BYTES or is_lfs_pointer(path):
+        if is_lfs_pointer(path):
             return None
         suffix = path.suffix.lower()
         if suffix == ".stl":
-            with path.open("rb") as handle:
-                head = handle.read(84 + _STL_ASCII_PROBE)
+            head = read_head(path, 84 + _STL_ASCII_PROBE, what="a mesh")
             if len(head) >= 84:
                 (count,) = struct.unpack_from("<I", head, 80)
                 if size == 84 + _STL_RECORD * count:
@@ -309,10 +400,10 @@ def _mesh_content(path: Path, size: int) -> tuple[str, int | None, int | None] |
                 return "stl-ascii", None, None
             return "stl-broken", None, None
         if suffix == ".obj":
-            statements = b"".join(_OBJ_STATEMENT.findall(path.read_bytes()))
+            statements = b"".join(_OBJ_STATEMENT.findall(read_mesh(path)))
             blocks = len(re.findall(rb"f+", statements))
             return "obj", statements.count(b"f"), blocks
-    except OSError:
+    except (OSError, UserError):
         return None
     return "other", None, None
 
@@ -353,7 +444,7 @@ def _hull_facts(path: Path) -> dict[str, float | bool] | None:
         return None
     try:
         corners = _corners(path, content[0])
-    except (OSError, ValueError, IndexError):
+    except (OSError, ValueError, IndexError, UserError):
         return None
     if not corners:
         return None
@@ -364,7 +455,7 @@ def _hull_facts(path: Path) -> dict[str, float | bool] | None:
 
 def _corners(path: Path, kind: str) -> list[tuple[float, float, float]] | None:
     """The triangles' corners, three per triangle in order (polygons fanned), or None."""
-    data = path.read_bytes()
+    data = read_mesh(path)
     if kind == "stl-binary":
         parsed = _stl_columns(data)
         if parsed is None:

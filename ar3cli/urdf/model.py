@@ -272,10 +272,23 @@ class Model:
 
     def parent_joint(self, link_name: str) -> Joint | None:
         """The joint whose child is ``link_name`` (the first one, if the file has several)."""
-        return next((j for j in self.joints if j.child == link_name), None)
+        return self._joints_by_child.get(link_name)
 
     def child_joints(self, link_name: str) -> list[Joint]:
-        return [j for j in self.joints if j.parent == link_name]
+        return list(self._joints_by_parent.get(link_name, ()))
+
+    @cached_property
+    def _joints_by_child(self) -> dict[str, Joint]:
+        """Indexed once, so rules asking for every link's parent stay linear in the number of joints."""
+        return {joint.child: joint for joint in reversed(self.joints) if joint.child is not None}
+
+    @cached_property
+    def _joints_by_parent(self) -> dict[str, list[Joint]]:
+        found: dict[str, list[Joint]] = {}
+        for joint in self.joints:
+            if joint.parent is not None:
+                found.setdefault(joint.parent, []).append(joint)
+        return found
 
     def root_links(self) -> list[Link]:
         """Links that are no joint's child. A well-formed robot has exactly one."""

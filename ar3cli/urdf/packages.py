@@ -65,15 +65,19 @@ def parse_package_paths(items: list[str] | None) -> dict[str, Path]:
     return mapping
 
 
+PACKAGE_XML_HEAD_BYTES = 65536
+"""Bytes of a package.xml searched for its <name> (it comes right after <package>)."""
+
+
 @lru_cache(maxsize=256)
 def _package_xml_name(folder: Path, _state: PathState | None = None) -> str | None:
     """The ``<name>`` in ``folder/package.xml`` (cached per state of the file: an edit is seen)."""
-    manifest = folder / "package.xml"
-    try:
-        if not manifest.is_file():  # missing, or a pipe that would never end
-            return None
-        match = _PACKAGE_NAME.search(manifest.read_bytes()[:65536])
-    except OSError:
+    from ar3cli.errors import UserError
+    from ar3cli.infra.safe_read import read_head
+
+    try:  # only the head: an ancestor's package.xml of 3 GB is not read whole; a pipe or device is refused
+        match = _PACKAGE_NAME.search(read_head(folder / "package.xml", PACKAGE_XML_HEAD_BYTES, what="a package.xml"))
+    except (OSError, UserError):  # missing, a folder, a pipe that would never end, unreadable
         return None
     return match.group(1).decode("utf-8", "replace") if match else None
 

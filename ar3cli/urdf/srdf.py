@@ -91,7 +91,7 @@ def read_srdf(path: Path) -> Srdf:
         raise UserError(f"{path}: is a directory, expected an .srdf file")
     if not path.exists():
         raise UserError(f"{path}: no such file (an existing SRDF was expected)")
-    data = read_bytes(path)
+    data = read_bytes(path, what="an .srdf file")
     refuse_entities(data, path)
     parser = etree.XMLParser(resolve_entities=False, no_network=True, load_dtd=False, huge_tree=False,
                              remove_blank_text=False)

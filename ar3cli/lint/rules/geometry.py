@@ -282,7 +282,7 @@ def _found_meshes(ctx):
           "its faces.",
       bad=_mesh_robot("meshes/part.stl"), good=_mesh_robot("meshes/base.stl"),
       thresholds="Binary STL: size == 84 + 50 x (triangle count in the header), count >= 1; OBJ: at least one "
-                 "'f' line.",
+                 "'f' line; any mesh: a regular file of at most 64 MB (meshinfo.MAX_MESH_BYTES).",
       references="PyBullet examples/Importers/ImportMeshUtility (LoadMeshFromSTL size check); MuJoCo "
                  "src/user/user_mesh.cc LoadSTL; google-deepmind/mujoco issue #327.")
 def mesh_unreadable(ctx) -> Iterator[Hit]:
@@ -303,6 +303,13 @@ def mesh_unreadable(ctx) -> Iterator[Hit]:
             problem = "holds no triangles: PyBullet drops the shape, MuJoCo refuses it"
         elif kind == "obj" and faces == 0:
             problem = "has vertices but no faces: a point cloud, not a surface"
+        elif kind == "too-large":
+            from ar3cli.urdf.meshinfo import MAX_MESH_BYTES
+
+            problem = (f"is larger than ar3cli's {MAX_MESH_BYTES // 1024 // 1024} MB limit for meshes: not read, and "
+                       "left out of what --sim loads; simplify or split it")
+        elif kind == "not-a-file":
+            problem = "is not a regular file (a pipe, socket or device): not read, and left out of what --sim loads"
         if problem:
             yield Hit(f"link '{link.name}' {shape.role} mesh {shape.geometry.filename} {problem}", shape.geometry.element)
 

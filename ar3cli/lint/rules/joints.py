@@ -293,11 +293,13 @@ def axis_not_unit(ctx) -> Iterator[Hit]:
       thresholds="Wheel-like names: " + ", ".join(WHEEL_LIKE) + ".")
 def continuous_arm_joint(ctx) -> Iterator[Hit]:
     model = ctx.model
+    below: _Below | None = None
     for joint in model.joints:
         if joint.type != "continuous" or joint.limit is not None or not joint.child:
             continue
-        downstream = _moving_descendants(model, joint.child)
-        if downstream and not _virtual_base_joint(model, joint) and _wheel_like_below(model, joint.child) is None:
+        below = below or _Below(model)
+        downstream = below.moving(joint.child)
+        if downstream and not _virtual_base_joint(model, joint) and not below.wheel(joint.child):
             yield Hit(f"continuous joint '{joint.name}' has no <limit> and carries {downstream} more moving joint"
                       f"{'s' if downstream != 1 else ''} and no wheel: an arm joint with no stops, effort 0 and "
                       "velocity 0 in PyBullet", joint.element)
@@ -312,36 +314,55 @@ def _virtual_base_joint(model, joint) -> bool:
     return above is not None and above.moves
 
 
-def _wheel_like_below(model, link_name: str) -> str | None:
-    """The first link at or below ``link_name`` that spins by design (see J011), or None."""
-    stack, seen = [link_name], {link_name}
-    while stack:
-        name = stack.pop()
+class _Below:
+    """For every link, computed once bottom-up (linear in the joints, also for a chain of thousands of
+    continuous joints): how many moving joints hang below it, and whether a link that spins by design
+    (see J011) is at or below it. A link reached again (a cycle or a second parent: S006's business)
+    adds nothing the second time."""
+
+    def __init__(self, model) -> None:
+        self.model = model
+        self._moving: dict[str, int] = {}
+        self._wheel: dict[str, bool] = {}
+
+    def moving(self, link_name: str) -> int:
+        self._fill(link_name)
+        return self._moving[link_name]
+
+    def wheel(self, link_name: str) -> bool:
+        self._fill(link_name)
+        return self._wheel[link_name]
+
+    def _fill(self, top: str) -> None:
+        """Post-order walk from ``top`` (iterative: no recursion limit on deep chains)."""
+        if top in self._moving:
+            return
+        model, moving, wheel = self.model, self._moving, self._wheel
+        started: set[str] = {top}
+        stack: list[tuple[str, bool]] = [(top, False)]
+        while stack:
+            name, children_done = stack.pop()
+            children = model.child_joints(name)
+            if not children_done:
+                stack.append((name, True))
+                for child in children:
+                    if child.child and child.child not in started and child.child not in moving:
+                        started.add(child.child)
+                        stack.append((child.child, False))
+                continue
+            moving[name] = sum(child.moves + moving.get(child.child or "", 0) for child in children)
+            wheel[name] = self._spins(name, moving[name]) or any(wheel.get(child.child or "", False) for child in children)
+
+    def _spins(self, name: str, moving_below: int) -> bool:
+        """True when the link itself spins by design: a wheel-like name, or a round, continuous leaf."""
         if any(fragment in name.lower() for fragment in WHEEL_LIKE):
-            return name
-        link = model.link(name)
-        above = model.parent_joint(name)
-        if link is not None and above is not None and above.type == "continuous" and not _moving_descendants(model, name):
-            shapes = link.collisions or link.visuals
-            if shapes and all(shape.geometry.kind in ("cylinder", "sphere") for shape in shapes):
-                return name
-        for child in model.child_joints(name):
-            if child.child and child.child not in seen:
-                seen.add(child.child)
-                stack.append(child.child)
-    return None
-
-
-def _moving_descendants(model, link_name: str) -> int:
-    """How many moving joints hang below ``link_name`` (cycles are S006's business: visited once)."""
-    count, stack, seen = 0, [link_name], {link_name}
-    while stack:
-        for child in model.child_joints(stack.pop()):
-            count += child.moves
-            if child.child and child.child not in seen:
-                seen.add(child.child)
-                stack.append(child.child)
-    return count
+            return True
+        link = self.model.link(name)
+        above = self.model.parent_joint(name)
+        if link is None or above is None or above.type != "continuous" or moving_below:
+            return False
+        shapes = link.collisions or link.visuals
+        return bool(shapes) and all(shape.geometry.kind in ("cylinder", "sphere") for shape in shapes)
 
 
 SINGLE_DOF_TYPES = ACTUATED_TYPES

@@ -126,17 +126,21 @@ def not_a_tree(ctx) -> Iterator[Hit]:
         for joint in joints[1:]:
             yield Hit(f"link '{child}' has {len(joints)} parent joints ({', '.join(j.name for j in joints)}); "
                       f"joint '{joint.name}' is one too many", joint.element)
-    # Cycles: follow the first parent joint upwards from every link.
+    # Cycles: follow the first parent joint upwards from every link, stopping at a link an earlier
+    # walk already went through (its way up is known), so every link is walked once: linear in the
+    # number of links, also for a chain of thousands.
     parent_of = {child: joints[0] for child, joints in parents.items()}
     reported: set[str] = set()
+    walked: set[str] = set()
     for start in parent_of:
-        seen: list[str] = []
+        seen: dict[str, int] = {}  # link -> position on this walk
         link = start
-        while link in parent_of and link not in seen:
-            seen.append(link)
+        while link in parent_of and link not in seen and link not in walked:
+            seen[link] = len(seen)
             link = parent_of[link].parent
+        walked.update(seen)
         if link in seen:
-            loop = seen[seen.index(link):]
+            loop = list(seen)[seen[link]:]
             key = min(loop)
             if key not in reported:
                 reported.add(key)
