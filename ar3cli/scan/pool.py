@@ -115,6 +115,9 @@ def _start(work: Callable[[Any], Any], items: Sequence[Any]) -> _Worker:
         pid = os.fork()
         if pid == 0:  # the worker: never returns
             try:
+                import faulthandler
+
+                faulthandler.disable()  # a crash is one row, not a stack dump on stderr
                 os.setpgid(0, 0)
                 child_signals(mask)
                 os.close(task_write)
