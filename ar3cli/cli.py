@@ -56,6 +56,8 @@ COMMANDS: dict[str, str] = {
     "fix-collision": "ar3cli.commands.fix_collision:fix_collision",
     "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",
     "diff": "ar3cli.commands.diff:diff",
+    "scan": "ar3cli.commands.scan:scan",
+    "scan-report": "ar3cli.commands.scan_report:scan_report",
 }
 """Every command, in the order ``--help`` lists them, and where its function is. A run imports
 only the module of the command it runs (see :func:`application`)."""

@@ -21,7 +21,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("application", ["cli"]),
     ("commands", ["commands"]),
     ("fixers", ["fix"]),
-    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor", "info", "robot_diff"]),
+    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor", "info", "robot_diff", "scan"]),
     ("simulation", ["sim"]),
     ("robot files", ["urdf"]),
     ("maths", ["physics"]),
