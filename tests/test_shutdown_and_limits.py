@@ -174,7 +174,7 @@ def test_a_child_out_of_memory_is_one_line(monkeypatch) -> None:
 
     with pytest.raises(OutOfMemoryError) as raised:
         run_isolated(greedy, "robot.urdf")
-    assert raised.value.message.startswith("robot.urdf: ran out of memory (the limit of a child process is 1.46 GB")
+    assert raised.value.message.startswith("robot.urdf: ran out of memory (the limit of a child process is 1.46 GB more than it starts with")
     assert raised.value.message.endswith("while reading a huge mesh")
     with pytest.raises(UserError, match=r"^in a test worker process: ran out of memory"):
         process_pool.map_in_processes(lambda item: len(bytearray(3 << 30)) if item else 0, [0, 1], 2,
@@ -222,7 +222,7 @@ def test_a_c_abort_under_the_memory_limit_names_both_likely_causes(monkeypatch) 
     with pytest.raises(CrashError) as raised:
         run_isolated(os.abort, "robot.urdf")
     assert raised.value.message.startswith("robot.urdf: pybullet crashed (SIGABRT) while running it: it ran out of "
-                                           "memory (the limit of a child process is 2 GB; set AR3CLI_CHILD_MEMORY_MB")
+                                           "memory (the limit of a child process is 2 GB more than it starts with; set AR3CLI_CHILD_MEMORY_MB")
     monkeypatch.setenv(child_limits.MEMORY_VARIABLE, "0")
     with pytest.raises(CrashError, match=r"\(SIGABRT\) while running it: a bug in pybullet's C code"):
         run_isolated(os.abort, "robot.urdf")

@@ -4,11 +4,14 @@ A robot file under lint may come from a stranger's pull request, and pybullet, V
 read its meshes in C: a 2 GB sparse STL asks for more than 8 GB, a FIFO named as a mesh blocks
 forever. So each child
 
-- gets ``RLIMIT_AS`` (:func:`memory_limit`: half of the physical memory, at most
-  :data:`MAX_MEMORY_BYTES`, at least :data:`MIN_MEMORY_BYTES`; ``AR3CLI_CHILD_MEMORY_MB`` overrides it,
-  0 for no limit). A child of ``sample-collisions`` on Romeo maps ~270 MB, so the cap only stops
-  runaway reads. Python then raises MemoryError (which comes back as a one-line error), or C code
-  aborts (a one-line crash report);
+- gets ``RLIMIT_AS``: it may map :func:`memory_limit` more than the address space it inherited
+  (half of the physical memory, at most :data:`MAX_MEMORY_BYTES`, at least :data:`MIN_MEMORY_BYTES`;
+  ``AR3CLI_CHILD_MEMORY_MB`` overrides it, 0 for no limit). Relative, because what a process has
+  mapped before it forks varies: ~0.5 GB for ar3cli itself, several GB of reservations in a Ray
+  worker (an absolute 4 GB cap there failed the next ``import lxml``). A child of
+  ``sample-collisions`` on Romeo maps ~270 MB more, so the cap only stops runaway reads. Python
+  then raises MemoryError (which comes back as a one-line error), or C code aborts (a one-line
+  crash report);
 - is given :func:`timeout` seconds of wall-clock time per file by the process that waits for it
   (the command's ``--timeout``, set with :func:`set_timeout`), then stopped;
 - dies with its parent (``prctl(PR_SET_PDEATHSIG, SIGKILL)``), even when the parent was killed
@@ -83,7 +86,7 @@ def memory_limit() -> int | None:
 def describe_memory_limit() -> str:
     """``4 GB``-style text for messages (``no limit``)."""
     limit = memory_limit()
-    return "no limit" if limit is None else f"{limit / (1 << 30):.3g} GB"
+    return "no limit" if limit is None else f"{limit / (1 << 30):.3g} GB more than it starts with"
 
 
 def prepare() -> None:
@@ -100,6 +103,15 @@ def prepare() -> None:
     _limit = memory_limit()
 
 
+def _mapped_bytes() -> int:
+    """This process's address space now (Linux: the first field of ``/proc/self/statm``; 0 elsewhere)."""
+    try:
+        with open("/proc/self/statm", "rb") as statm:
+            return int(statm.read().split()[0]) * os.sysconf("SC_PAGE_SIZE")
+    except (OSError, ValueError, IndexError):
+        return 0
+
+
 def enter_child(parent: int) -> None:
     """In a just-forked child (after :func:`prepare` in the parent): die with ``parent`` (SIGKILL
     when it ends; ending now if it is already gone: it may have died before the request was made),
@@ -114,6 +126,7 @@ def enter_child(parent: int) -> None:
     if limit is not None:
         import resource
 
+        limit += _mapped_bytes()
         try:
             soft, hard = resource.getrlimit(resource.RLIMIT_AS)
             if hard != resource.RLIM_INFINITY:
