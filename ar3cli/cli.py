@@ -133,21 +133,29 @@ def _main(argv: list[str] | None) -> None:
     except usage_error as exc:
         command = exc.ctx.command_path if getattr(exc, "ctx", None) is not None else "ar3cli"
         message = " ".join(exc.format_message().replace("Value error, ", "").split())
-        print(f"ar3cli: error: {message} (see '{command} --help')", file=sys.stderr)
+        _say(f"ar3cli: error: {message} (see '{command} --help')")
         sys.exit(EXIT_USAGE)
     except typer.Abort:
         _interrupted()
     except UserError as exc:
-        print(f"ar3cli: error: {exc.message}", file=sys.stderr)
+        _say(f"ar3cli: error: {exc.message}")
         sys.exit(exc.exit_code)
     except KeyboardInterrupt:
         _interrupted()
     except Exception as exc:  # a bug in ar3cli: one line unless debugging
         if os.environ.get("AR3CLI_DEBUG"):
             raise
-        print(f"ar3cli: internal error: {type(exc).__name__}: {exc} (rerun with AR3CLI_DEBUG=1 for a traceback "
-              "and report it)", file=sys.stderr)
+        _say(f"ar3cli: internal error: {type(exc).__name__}: {exc} (rerun with AR3CLI_DEBUG=1 for a traceback "
+             "and report it)")
         sys.exit(EXIT_INTERNAL)
+
+
+def _say(line: str) -> None:
+    """Print one error line on stderr, control characters shown, not obeyed (a file name is the
+    attacker's text: an escape sequence in it must not rewrite the terminal or a CI log)."""
+    from ar3cli.output.report import printable
+
+    print(printable(line), file=sys.stderr)
 
 
 def run() -> None:

@@ -95,6 +95,13 @@ def test_control_characters_are_neutralised_in_text_github_markdown_and_kept_in_
     assert data["findings"][0]["path"] == name and "j\r\u202eok\u009b" in data["findings"][0]["message"]
 
 
+def test_error_lines_show_control_characters_in_file_names(cli, tmp_path):
+    for command in (["info"], ["fk-verify"], ["lint-urdf", "--format", "json"]):
+        result = cli(*command, "missing\x1b[2J\x07.urdf", cwd=tmp_path)
+        assert result.code == 2 and "missing\\x1b[2J\\x07.urdf" in result.stderr, command
+        assert "\x1b" not in result.stderr and "\x07" not in result.stderr, command
+
+
 # ---- 3. tables fit the width ---------------------------------------------------------------------------
 
 WIDE = Table(title="t.urdf", columns=["location", "code", "severity", "message", "hint"],
