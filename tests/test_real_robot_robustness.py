@@ -119,7 +119,7 @@ def test_lint_sim_batch_reports_every_file_when_pybullet_crashes_on_one(cli, tmp
 def test_lint_sim_with_jobs_reports_the_crash_as_well(cli) -> None:
     result = cli("lint-urdf", "--sim", "--no-cache", "--jobs", "2", str(DATA))
     assert result.code == 2, result.stderr
-    assert "5 files checked" in result.stdout and "1 not fully checked (pybullet crashed)" in result.stdout
+    assert "5 files checked" in result.stdout and "1 not fully checked (pybullet crashed, or ran out of time or memory)" in result.stdout
     assert result.stderr.count("pybullet crashed") == 1
 
 

@@ -294,7 +294,7 @@ def summary_line(summary: dict, cached: int = 0) -> str:
     broken = summary["files_not_checked"]
     clean = summary["files_clean"]
     verdict = "FAILED" if summary["failed"] else "passed"
-    unchecked = f"; {broken} not fully checked (pybullet crashed)" if broken else ""
+    unchecked = f"; {broken} not fully checked (pybullet crashed, or ran out of time or memory)" if broken else ""
     remembered = f"; {cached} unchanged since an earlier run (from the cache)" if cached else ""
     held = ""
     if summary.get("baselined") is not None:

@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.infra.git import run_git
 from ar3cli.lint.engine import collect_files, display_path
 
 
@@ -74,17 +75,8 @@ def select_changed(paths: Iterable[Path], ref: str, package_paths: Mapping[str, 
 
 
 def _git(root: Path | str, *args: str, stdin: str | None = None) -> subprocess.CompletedProcess:
-    """Run ``git -C root ARGS`` read-only and capture its output (bytes when ``stdin`` is None)."""
-    environment = {**os.environ, "GIT_OPTIONAL_LOCKS": "0", "LC_ALL": "C"}
-    try:
-        return subprocess.run(["git", "-C", str(root), "-c", "diff.autoRefreshIndex=false", *args],
-                              capture_output=True, env=environment, stdin=subprocess.DEVNULL if stdin is None else None,
-                              input=stdin.encode("utf-8", "surrogateescape") if stdin is not None else None,
-                              timeout=300)
-    except FileNotFoundError:
-        raise UserError("--changed-since needs git, and no git command was found") from None
-    except subprocess.TimeoutExpired:
-        raise UserError(f"--changed-since: git took longer than 5 minutes in {root}") from None
+    """``git -C root ARGS``, read-only (:func:`~ar3cli.infra.git.run_git`)."""
+    return run_git(root, *args, purpose="--changed-since", stdin=stdin)
 
 
 def _repo_root(path: Path) -> str:

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from ar3cli.errors import UserError
+from ar3cli.infra.git import run_git
 
 MAX_BYTES = 512 * 1024 * 1024
 """Largest robot folder copied out of a revision (example-robot-data's whole robots/ tree is ~200 MB)."""
@@ -57,15 +58,8 @@ class Side:
 
 
 def git(root: Path | str, *args: str) -> subprocess.CompletedProcess:
-    """``git -C root ARGS``, read-only (no optional locks, no index refresh), bytes captured."""
-    environment = {**os.environ, "GIT_OPTIONAL_LOCKS": "0", "LC_ALL": "C"}
-    try:
-        return subprocess.run(["git", "-C", str(root), "-c", "diff.autoRefreshIndex=false", *args],
-                              capture_output=True, env=environment, stdin=subprocess.DEVNULL, timeout=300)
-    except FileNotFoundError:
-        raise UserError("reading a git revision needs git, and no git command was found") from None
-    except subprocess.TimeoutExpired:
-        raise UserError(f"git took longer than 5 minutes in {root}") from None
+    """``git -C root ARGS``, read-only (:func:`~ar3cli.infra.git.run_git`), bytes captured."""
+    return run_git(root, *args, purpose="reading a git revision")
 
 
 def split_spec(spec: str) -> tuple[str | None, str]:
