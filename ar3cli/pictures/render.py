@@ -20,6 +20,7 @@ from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.infra.atomic import atomic_write
+from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 from ar3cli.urdf.model import Model
 
 CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
@@ -79,8 +80,6 @@ def showing_collision_geometry(model: Model) -> Model:
     return overlay
 
 
-DRAWABLE_MESH_FORMATS = (".stl", ".obj", ".dae")
-"""What pybullet loads as a visual mesh (lint-urdf's G004): anything else makes it refuse the whole file."""
 
 
 def undrawable_reason(shape: Any) -> str | None:
@@ -92,7 +91,7 @@ def undrawable_reason(shape: Any) -> str | None:
     if resolution is not None and not resolution.found:
         return f"mesh {resolution.explain()}"
     suffix = Path((geometry.filename or "").strip()).suffix.lower()
-    if suffix not in DRAWABLE_MESH_FORMATS:
+    if suffix not in PYBULLET_MESH_FORMATS:
         return f"pybullet cannot load '{suffix or 'no extension'}' meshes ({geometry.filename})"
     return None
 

@@ -27,6 +27,9 @@ from ar3cli.errors import UserError
 from ar3cli.infra.file_cache import MISSING, file_facts
 from ar3cli.infra.safe_read import read_bytes, read_head, too_large
 
+PYBULLET_MESH_FORMATS = (".stl", ".obj", ".dae")
+"""What PyBullet's URDF importer loads (anything else: "invalid mesh filename extension", and the
+whole file is refused): lint-urdf's G004, and what render can draw."""
 LFS_POINTER_PREFIX = b"version https://git-lfs.github.com/spec/"
 LFS_POINTER_MAX_BYTES = 1024
 """Git LFS's specification: "Pointer files must be less than 1024 bytes in size"."""

@@ -8,9 +8,8 @@ from pathlib import Path
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.urdf.bounds import scaled_mesh_bounds
+from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 
-PYBULLET_MESH_FORMATS = (".stl", ".obj", ".dae")
-"""What PyBullet's URDF importer loads (anything else: "invalid mesh filename extension")."""
 MAX_PLAUSIBLE_EXTENT = 5.0
 """A robot part larger than this many metres after scaling is almost always a mesh in millimetres."""
 MIN_PLAUSIBLE_EXTENT = 1e-3
