@@ -54,6 +54,7 @@ COMMANDS: dict[str, str] = {
     "fix-mesh-paths": "ar3cli.commands.fix_mesh_paths:fix_mesh_paths",
     "fix-collision": "ar3cli.commands.fix_collision:fix_collision",
     "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",
+    "cross-check": "ar3cli.commands.cross_check:cross_check",
 }
 """Every command, in the order ``--help`` lists them, and where its function is. A run imports
 only the module of the command it runs (see :func:`application`)."""
