@@ -21,7 +21,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("application", ["cli"]),
     ("commands", ["commands"]),
     ("fixers", ["fix"]),
-    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor", "info"]),
+    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor", "info", "cross_check"]),
     ("simulation", ["sim"]),
     ("robot files", ["urdf"]),
     ("maths", ["physics"]),
