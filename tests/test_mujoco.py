@@ -115,3 +115,20 @@ def _cube_stl(size: float) -> str:
         lines += ["facet normal 0 0 0", "outer loop", *(f"vertex {x} {y} {z}" for x, y, z in
                                                        (corners[a], corners[b], corners[c])), "endloop", "endfacet"]
     return "\n".join([*lines, "endsolid cube"]) + "\n"
+
+
+def test_engine_without_sim_is_a_usage_error():
+    result = run("lint-urdf", "--engine", "mujoco", str(FREE))
+    assert result.returncode == 2 and "add --sim" in result.stderr
+
+
+def test_mujoco_compile_error_names_the_link_and_its_line(tmp_path):
+    from ar3cli.lint.rules.base import arm
+
+    path = tmp_path / "r.urdf"
+    path.write_text(arm(link_extra='<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" '
+                                   'izz="5"/></inertial>'))
+    result = run("cross-check", str(path), "-n", "1")
+    assert result.returncode == 2
+    assert f"{path}:4: MuJoCo cannot compile it: inertia must satisfy A + B >= C" in result.stderr
+    assert "(link 'arm')" in result.stderr

@@ -95,7 +95,10 @@ class MjRobot:
             text = str(exc).replace(str(folder) + "/", "").strip()
             reason = text.removeprefix("Error: ").splitlines()[0] if text else "MuJoCo gave no reason"
             element = named_element(model, str(exc), built.mesh_elements)
-            raise MujocoCompileError(f"{model.path}: MuJoCo cannot compile it: {reason}", reason, element) from None
+            named = f" ({element.tag} '{element.get('name')}')" if element is not None and element.get("name") else ""
+            where = f"{model.path}:{element.sourceline}" if element is not None and element.sourceline else str(model.path)
+            raise MujocoCompileError(f"{where}: MuJoCo cannot compile it: {reason}{named}", reason + named,
+                                     element) from None
         finally:
             mujoco.set_mju_user_warning(previous)
         self.m.opt.gravity[:] = (0.0, 0.0, gravity)

@@ -64,8 +64,11 @@ def mujoco_compile_failed(ctx) -> Iterator[Hit]:
 
     robot, error = _compiled(ctx)
     if error is not None:
-        element = error.element if isinstance(error, MujocoCompileError) else None
-        yield Hit(error.message.removeprefix(f"{ctx.model.path}: "), element if element is not None else ctx.model.root)
+        if isinstance(error, MujocoCompileError):
+            yield Hit(f"MuJoCo cannot compile it: {error.reason}",
+                      error.element if error.element is not None else ctx.model.root)
+        else:
+            yield Hit(error.message.removeprefix(f"{ctx.model.path}: "), ctx.model.root)
 
 
 _DAE = robot(f"""
