@@ -132,3 +132,15 @@ def test_mujoco_compile_error_names_the_link_and_its_line(tmp_path):
     assert result.returncode == 2
     assert f"{path}:4: MuJoCo cannot compile it: inertia must satisfy A + B >= C" in result.stderr
     assert "(link 'arm')" in result.stderr
+
+
+def test_mujoco_xml_error_points_at_the_users_line(tmp_path):
+    from ar3cli.lint.rules.base import arm
+
+    path = tmp_path / "r.urdf"
+    text = arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/>\n    <origin xyz="0.07, 0, 0"/>')
+    path.write_text(text)
+    line = text.splitlines().index('    <origin xyz="0.07, 0, 0"/>') + 1
+    result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M001", "--format", "json", str(path))
+    (finding,) = json.loads(result.stdout)["findings"]
+    assert "bad format in attribute 'xyz'" in finding["message"] and finding["line"] == line

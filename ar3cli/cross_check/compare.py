@@ -122,7 +122,7 @@ def _dynamics(model: Model, plan: Plan, pb: EngineData, mj: EngineData) -> list[
     import numpy as np
 
     index = [pb.joints.index(name) for name in mj.joints]
-    if not index:
+    if not index or not any(pb.mass_matrix):
         return []
     rows = []
     armature = {n: a for n, a in mj.extra.get("armature", {}).items() if a}

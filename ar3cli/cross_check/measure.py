@@ -20,6 +20,8 @@ DRIVE_SECONDS = 0.5
 """How long the constraint probe drives a leader joint. MuJoCo's joint equality (default solref
 0.02 s, critically damped) brings a mimic follower to within 1e-6 rad of its target in this time
 (measured on pybullet_data's panda finger)."""
+MULTI_DOF_TYPES = ("spherical", "planar", "floating")
+"""Joints PyBullet's calculateMassMatrix / calculateInverseDynamics do not take as one value each."""
 DRIVE_STEP = 0.05
 """rad or m a leader joint is moved by the probe (a quarter of its range when that is smaller)."""
 
@@ -83,6 +85,7 @@ def _plan(body: Any, samples: int, seed: int) -> Plan:
 
 
 def _pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
+    from ar3cli.sim.capture import capture_fds
     from ar3cli.sim.session import Session
 
     with Session(gravity=GRAVITY) as session:
@@ -95,14 +98,24 @@ def _pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
         data.link_masses = {name: body.dynamics(name).mass for name in body.link_names[1:]}
         data.mass = sum(data.link_masses.values())
         zeros = [0.0] * len(plan.joints)
+        multi = [joint for joint in body.joints if joint.urdf_type in MULTI_DOF_TYPES]
+        if multi:
+            data.notes.append(f"mass matrix and gravity torques not compared: joint '{multi[0].name}' is "
+                              f"{multi[0].urdf_type} (ar3cli compares 1-DOF joints only)")
         for _, configuration in plan.configurations:
             body.set_positions(configuration)
             q = [configuration[name] for name in plan.joints]
             data.frames.append(body.link_frames())
             data.com.append(_pybullet_com(body))
-            if plan.joints:
-                data.mass_matrix.append([list(row) for row in p.calculateMassMatrix(body.id, q, physicsClientId=client)])
-                data.gravity.append(list(p.calculateInverseDynamics(body.id, q, zeros, zeros, physicsClientId=client)))
+            if plan.joints and not multi:
+                with capture_fds() as captured:  # Bullet's inverse dynamics prints warnings from C (romeo: axes)
+                    matrix = p.calculateMassMatrix(body.id, q, physicsClientId=client)
+                    torques = p.calculateInverseDynamics(body.id, q, zeros, zeros, physicsClientId=client)
+                data.mass_matrix.append([list(row) for row in matrix])
+                data.gravity.append(list(torques))
+                for message in captured.messages:
+                    if message not in data.notes:
+                        data.notes.append(f"PyBullet: {message}")
             else:
                 data.mass_matrix.append([])
                 data.gravity.append([])

@@ -53,7 +53,7 @@ def cross_check(model: Model, path: Path, samples: int, seed: int, stability: bo
 
 
 def _notes(pb: Any, mj: Any) -> list[str]:
-    notes = list(mj.notes)
+    notes = list(dict.fromkeys([*pb.notes, *mj.notes]))
     fused = mj.extra.get("fused", 0)
     if fused:
         notes.append(f"MuJoCo's default compile fuses {fused} link(s) joined by fixed joints into their parents "

@@ -57,6 +57,8 @@ class MujocoCopy:
     substitutions: list[Substitution]
     mesh_elements: dict[str, Any]
     """Linked mesh path (as MuJoCo quotes it) -> the user's ``<mesh>`` element."""
+    lines: dict[int, Any]
+    """Line of the copy that starts an element -> :class:`~ar3cli.sim.loadable_copy.Place` in the user's file."""
 
 
 def mujoco_copy(model: Model, folder: Path, fuse: bool = True) -> MujocoCopy:
@@ -92,8 +94,11 @@ def mujoco_copy(model: Model, folder: Path, fuse: bool = True) -> MujocoCopy:
     for element in list(root.iter("visual")):
         element.getparent().remove(element)
     _set_compiler(root, fuse)
+    etree.indent(root, space=" ")  # one element per line, so MuJoCo's "line N" names one element
     document = etree.tostring(root, xml_declaration=True, encoding="utf-8")
-    return MujocoCopy(document, substitutions, mesh_elements)
+    from ar3cli.sim.loadable_copy import line_map
+
+    return MujocoCopy(document, substitutions, mesh_elements, line_map(model, root, document))
 
 
 def _link_file(path: Path, folder: Path, index: int) -> str:

@@ -32,6 +32,7 @@ from ar3cli.urdf.model import Model
 Result = TypeVar("Result")
 INSTALL_HINT = "pip install 'ar3cli[mujoco]'"
 _ELEMENT = re.compile(r"Element name '([^']*)'")
+_LINE = re.compile(r"Element '[^']*', line (\d+)")
 
 
 def import_mujoco() -> Any:
@@ -72,6 +73,13 @@ def named_element(model: Model, message: str, mesh_elements: Mapping[str, Any] |
     return None
 
 
+def _element_at(model: Model, line: int) -> Any:
+    """The first element of the user's (URDF) model starting on ``line``, for the lint finding; None for a xacro."""
+    if model.is_xacro:
+        return None
+    return next((node for node in model.root.iter() if isinstance(node.tag, str) and node.sourceline == line), None)
+
+
 class MjRobot:
     """A Model compiled by MuJoCo: its MjModel/MjData, the meshes replaced, the compiler's warnings."""
 
@@ -97,6 +105,11 @@ class MjRobot:
             element = named_element(model, str(exc), built.mesh_elements)
             named = f" ({element.tag} '{element.get('name')}')" if element is not None and element.get("name") else ""
             where = f"{model.path}:{element.sourceline}" if element is not None and element.sourceline else str(model.path)
+            line = _LINE.search(str(exc))
+            place = built.lines.get(int(line.group(1))) if line and element is None else None
+            if place is not None:  # an XML error: MuJoCo quotes the copy's line; say the user's
+                where = f"{place.file}:{place.line}"
+                element = _element_at(model, place.line)
             raise MujocoCompileError(f"{where}: MuJoCo cannot compile it: {reason}{named}", reason + named,
                                      element) from None
         finally:
