@@ -61,13 +61,20 @@ def test_collada_and_missing_meshes_are_boxed_and_reported(tmp_path):
     from ar3cli.lint.rules.base import LINK_INERTIAL, robot
 
     (tmp_path / "part.dae").write_text("<COLLADA/>")
+    (tmp_path / "ascii.stl").write_bytes(_cube_stl(0.1, binary=False))
+    (tmp_path / "binary.stl").write_bytes(_cube_stl(0.1))
     path = tmp_path / "r.urdf"
     path.write_text(robot(f"""
         <link name="base">{LINK_INERTIAL}<collision><geometry><mesh filename="part.dae"/></geometry></collision>
-          <collision><geometry><mesh filename="gone.stl"/></geometry></collision></link>"""))
+          <collision><geometry><mesh filename="gone.stl"/></geometry></collision>
+          <collision><geometry><mesh filename="ascii.stl"/></geometry></collision>
+          <collision><geometry><mesh filename="binary.stl"/></geometry></collision></link>"""))
     result = run("lint-urdf", "--sim", "--engine", "all", "--select", "M", "--format", "json", str(path))
-    rules = sorted(f["rule"] for f in json.loads(result.stdout)["findings"])
-    assert rules == ["M002", "M002"], result.stdout
+    findings = json.loads(result.stdout)["findings"]
+    assert sorted(f["rule"] for f in findings) == ["M002", "M002", "M002"], result.stdout
+    messages = " ".join(f["message"] for f in findings)
+    assert "ASCII STL" in messages and "replaced by its 0.1 x 0.1 x 0.1 m box" in messages
+    assert "'gone.stl' is not found" in messages and "binary.stl" not in messages
 
 
 def test_same_named_meshes_in_two_folders_stay_two_meshes(tmp_path):
@@ -76,7 +83,7 @@ def test_same_named_meshes_in_two_folders_stay_two_meshes(tmp_path):
 
     for folder, size in (("a", 1.0), ("b", 2.0)):
         (tmp_path / folder).mkdir()
-        (tmp_path / folder / "part.stl").write_text(_cube_stl(size))
+        (tmp_path / folder / "part.stl").write_bytes(_cube_stl(size))
     path = tmp_path / "r.urdf"
     path.write_text('<robot name="r"><link name="base"><collision><geometry><mesh filename="a/part.stl"/></geometry>'
                     '</collision><collision><geometry><mesh filename="b/part.stl"/></geometry></collision></link></robot>')
@@ -104,17 +111,22 @@ def test_missing_extra_is_one_line(monkeypatch):
     assert "pip install 'ar3cli[mujoco]'" in caught.value.message and "\n" not in caught.value.message
 
 
-def _cube_stl(size: float) -> str:
-    """An ASCII STL cube of edge ``size`` (12 triangles)."""
+def _cube_stl(size: float, binary: bool = True) -> bytes:
+    """An STL cube of edge ``size`` (12 triangles), binary (what MuJoCo reads) or ASCII (what it refuses)."""
+    import struct
+
     s = size
     corners = [(x, y, z) for x in (0, s) for y in (0, s) for z in (0, s)]
     faces = [(0, 1, 3), (0, 3, 2), (4, 6, 7), (4, 7, 5), (0, 4, 5), (0, 5, 1),
              (2, 3, 7), (2, 7, 6), (0, 2, 6), (0, 6, 4), (1, 5, 7), (1, 7, 3)]
+    if binary:
+        body = b"".join(struct.pack("<12fH", 0, 0, 0, *corners[a], *corners[b], *corners[c], 0) for a, b, c in faces)
+        return b"\0" * 80 + struct.pack("<I", len(faces)) + body
     lines = ["solid cube"]
     for a, b, c in faces:
         lines += ["facet normal 0 0 0", "outer loop", *(f"vertex {x} {y} {z}" for x, y, z in
                                                        (corners[a], corners[b], corners[c])), "endloop", "endfacet"]
-    return "\n".join([*lines, "endsolid cube"]) + "\n"
+    return ("\n".join([*lines, "endsolid cube"]) + "\n").encode()
 
 
 def test_engine_without_sim_is_a_usage_error():

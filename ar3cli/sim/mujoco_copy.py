@@ -8,8 +8,8 @@ MuJoCo is given a temporary copy, never the user's file, because the file as wri
   folders would be one mesh. Each mesh file the resolver finds is linked into a private folder
   under a unique name (``<n>_<name>``) and named by that absolute path, with
   ``<mujoco><compiler strippath="false"/></mujoco>``.
-- MuJoCo reads STL, OBJ and MSH only: a COLLADA file (or any other format) is an "Error opening
-  file" that stops the whole compile, as is a missing file. Such a mesh is replaced by its box
+- MuJoCo reads binary STL, OBJ and MSH only: a COLLADA file (or any other format) is an "Error
+  opening file" that stops the whole compile, as is a missing file or an ASCII STL. Such a mesh is replaced by its box
   (:func:`~ar3cli.urdf.bounds.metric_mesh_bounds`, centred where the mesh is), or left out when
   its size is unknown, and reported (:class:`Substitution`), so the rest is still checked.
 - Visuals are dropped (MuJoCo's URDF default ``discardvisual="true"`` does the same; dropping them
@@ -79,7 +79,7 @@ def mujoco_copy(model: Model, folder: Path, fuse: bool = True) -> MujocoCopy:
             if mesh is None or mesh not in twin:
                 continue
             resolution = geometry.resolution
-            if resolution is not None and resolution.found and resolution.path.suffix.lower() in MUJOCO_MESH_SUFFIXES:
+            if resolution is not None and resolution.found and mujoco_reads(resolution.path):
                 if resolution.path not in linked:
                     linked[resolution.path] = _link_file(resolution.path, folder, len(linked))
                 twin[mesh].set("filename", linked[resolution.path])
@@ -87,6 +87,8 @@ def mujoco_copy(model: Model, folder: Path, fuse: bool = True) -> MujocoCopy:
                 continue
             reason = (f"'{geometry.filename}' is not found ({resolution.explain()})"
                       if resolution is None or not resolution.found else
+                      f"'{geometry.filename}' is an ASCII STL: MuJoCo reads binary STL only"
+                      if resolution.path.suffix.lower() == ".stl" else
                       f"'{geometry.filename}' is {resolution.path.suffix or 'a file without suffix'}: MuJoCo reads "
                       "STL, OBJ and MSH meshes only")
             replacement = _replace_with_box(shape, twin[mesh], twin.get(shape.element))
@@ -99,6 +101,24 @@ def mujoco_copy(model: Model, folder: Path, fuse: bool = True) -> MujocoCopy:
     from ar3cli.sim.loadable_copy import line_map
 
     return MujocoCopy(document, substitutions, mesh_elements, line_map(model, root, document))
+
+
+def mujoco_reads(path: Path) -> bool:
+    """Whether MuJoCo's compiler reads this mesh file: OBJ, MSH, or a *binary* STL (an ASCII STL is refused:
+    "stl_decoder: number of faces should be between 1 and 200000 ...; perhaps this is an ASCII file?",
+    measured on example-robot-data's simple_humanoid). A binary STL is 84 bytes plus 50 per triangle."""
+    suffix = path.suffix.lower()
+    if suffix not in MUJOCO_MESH_SUFFIXES:
+        return False
+    if suffix != ".stl":
+        return True
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as handle:
+            header = handle.read(84)
+    except OSError:
+        return False
+    return len(header) == 84 and size == 84 + 50 * int.from_bytes(header[80:84], "little")
 
 
 def _link_file(path: Path, folder: Path, index: int) -> str:

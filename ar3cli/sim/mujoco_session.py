@@ -101,8 +101,13 @@ class MjRobot:
             self.m = mujoco.MjModel.from_xml_path(str(path))
         except ValueError as exc:
             text = str(exc).replace(str(folder) + "/", "").strip()
+            for linked, mesh in built.mesh_elements.items():  # MuJoCo names a mesh by its linked file's stem
+                text = re.sub(rf"(?<![\w.]){re.escape(Path(linked).stem)}(?![\w])", f"'{mesh.get('filename')}'", text)
             reason = text.removeprefix("Error: ").splitlines()[0] if text else "MuJoCo gave no reason"
             element = named_element(model, str(exc), built.mesh_elements)
+            if element is None:
+                element = next((mesh for linked, mesh in built.mesh_elements.items()
+                                if re.search(rf"(?<![\w.]){re.escape(Path(linked).stem)}(?![\w])", str(exc))), None)
             named = f" ({element.tag} '{element.get('name')}')" if element is not None and element.get("name") else ""
             where = f"{model.path}:{element.sourceline}" if element is not None and element.sourceline else str(model.path)
             line = _LINE.search(str(exc))
