@@ -67,7 +67,21 @@ def compare(model: Model, plan: Plan, pb: EngineData, mj: EngineData) -> list[Ro
     """Every compared value (the worst per quantity and place), worst first by how far past its tolerance."""
     rows = [*_frames(plan, pb, mj), *_masses(model, pb, mj), *_dynamics(model, plan, pb, mj),
             *_constraints(model, plan, pb, mj)]
-    return sorted(rows, key=lambda row: -row.ratio)
+    return sorted(_consequences(rows), key=lambda row: -row.ratio)
+
+
+def _consequences(rows: list[Row]) -> list[Row]:
+    """Undiagnosed mass, centre-of-mass and dynamics rows that follow from a link mass the engines disagree on."""
+    import dataclasses
+
+    links = [row.where for row in rows if row.quantity == "link mass (kg)" and not row.agrees]
+    if not links:
+        return rows
+    cause = "follows from the link masses the engines disagree on (" + ", ".join(links[:3]) + \
+        (" ..." if len(links) > 3 else "") + ")"
+    following = ("total mass (kg)", "centre of mass (m)", "mass matrix entry", "gravity torque (N m)")
+    return [dataclasses.replace(row, diagnosis=cause) if row.quantity in following and not row.agrees
+            and not row.diagnosis else row for row in rows]
 
 
 def _angle(a: tuple[float, ...], b: tuple[float, ...]) -> float:
@@ -113,8 +127,9 @@ def _masses(model: Model, pb: EngineData, mj: EngineData) -> list[Row]:
 def _mass_diagnosis(model: Model, link: str, mass_pb: float, mass_mj: float) -> str:
     found = model.link(link)
     if found is not None and found.inertial is None:
-        return (f"link '{link}' has no <inertial>: PyBullet gives it {mass_pb:g} kg, MuJoCo computes "
-                f"{mass_mj:.4g} kg from its collision geometry at 1000 kg/m3; give it an <inertial>")
+        mujoco = (f"MuJoCo computes {mass_mj:.4g} kg from its collision geometry at 1000 kg/m3" if mass_mj > 0 else
+                  "MuJoCo gives it none (no collision geometry; allowed on a body that moves with its parent)")
+        return f"link '{link}' has no <inertial>: PyBullet gives it {mass_pb:g} kg, {mujoco}; give it an <inertial>"
     return ""
 
 

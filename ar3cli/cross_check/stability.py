@@ -80,11 +80,11 @@ def _pybullet_drop(model: Model, step: float) -> dict[str, Any]:
 
 
 def _mujoco_drop(model: Model, step: float) -> dict[str, Any]:
-    from ar3cli.sim.mujoco_session import MjRobot
+    from ar3cli.sim.mujoco_session import MjRobot, home_pose
 
     robot = MjRobot(model, fuse=False)
     robot.m.opt.timestep = step
-    robot.set_positions(_home(model))
+    robot.set_positions(home_pose(model))
     frames = robot.link_frames()
     scale = robot.total_mass() * 9.81 * max(0.1, *(math.hypot(*pose[0]) for pose in frames.values()))
     energies = [robot.energy()]
@@ -95,20 +95,3 @@ def _mujoco_drop(model: Model, step: float) -> dict[str, Any]:
             break
     return _verdict("mujoco", step, energies, scale)
 
-
-def _home(model: Model) -> dict[str, float]:
-    """0, or mid-range where 0 is outside the limits (MoveIt's convention, as the sampler's home); mimic joints follow."""
-    import numpy as np
-
-    from ar3cli.urdf.mimic import driven_values
-
-    home = {}
-    for joint in model.movable_joints():
-        limit = joint.limit
-        lower, upper = (limit.lower, limit.upper) if limit is not None else (None, None)
-        inside = lower is None or upper is None or not lower <= upper or lower <= 0.0 <= upper
-        home[joint.name] = 0.0 if inside else (lower + upper) / 2.0
-    given = {name: np.array([value]) for name, value in home.items()
-             if model.joint(name) is None or model.joint(name).mimic is None}
-    home.update({name: float(values[0]) for name, values in driven_values(model, given, 1).items()})
-    return home

@@ -73,6 +73,24 @@ def named_element(model: Model, message: str, mesh_elements: Mapping[str, Any] |
     return None
 
 
+def home_pose(model: Model) -> dict[str, float]:
+    """The home pose from the URDF alone (no PyBullet body): each 1-DOF joint at 0, or mid-range where 0 is
+    outside its limits (MoveIt's convention, as :func:`ar3cli.sim.sampling.home_positions`); mimic joints follow."""
+    import numpy as np
+
+    from ar3cli.urdf.mimic import driven_values
+
+    home = {}
+    for joint in model.movable_joints():
+        limit = joint.limit
+        lower, upper = (limit.lower, limit.upper) if limit is not None else (None, None)
+        inside = lower is None or upper is None or not lower <= upper or lower <= 0.0 <= upper
+        home[joint.name] = 0.0 if inside else (lower + upper) / 2.0
+    given = {name: np.array([value]) for name, value in home.items() if model.joint(name).mimic is None}
+    home.update({name: float(values[0]) for name, values in driven_values(model, given, 1).items()})
+    return home
+
+
 def _element_at(model: Model, line: int) -> Any:
     """The first element of the user's (URDF) model starting on ``line``, for the lint finding; None for a xacro."""
     if model.is_xacro:

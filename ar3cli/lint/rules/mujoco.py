@@ -35,21 +35,6 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
     return getattr(ctx, _COMPILED)
 
 
-def _home(ctx: Any) -> dict[str, float]:
-    from ar3cli.urdf.mimic import driven_values
-
-    home = {}
-    for joint in ctx.model.movable_joints():
-        limit = joint.limit
-        lower, upper = (limit.lower, limit.upper) if limit is not None else (None, None)
-        inside = lower is None or upper is None or not lower <= upper or lower <= 0.0 <= upper
-        home[joint.name] = 0.0 if inside else (lower + upper) / 2.0
-    import numpy as np
-
-    given = {name: np.array([value]) for name, value in home.items() if ctx.model.joint(name).mimic is None}
-    home.update({name: float(values[0]) for name, values in driven_values(ctx.model, given, 1).items()})
-    return home
-
 
 @rule("M001", "mujoco-compile-failed", "error", "MuJoCo refuses to compile the model",
       why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
@@ -114,12 +99,13 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
       thresholds="Deeper than PENETRATION = 1e-6 m, as P002.")
 def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import adjacent_pairs, rigid_groups
+    from ar3cli.sim.mujoco_session import home_pose
     from ar3cli.urdf.srdf import is_disabled
 
     robot, _ = _compiled(ctx)
     if robot is None:
         return
-    robot.set_positions(_home(ctx))
+    robot.set_positions(home_pose(ctx.model))
     adjacent = adjacent_pairs(ctx.model)
     group = rigid_groups(ctx.model, robot.joint_ids)
     for a, b, depth in robot.contacts(PENETRATION):
@@ -146,10 +132,12 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
       good=arm(), needs_sim=True,
       thresholds="NaN, mjWARN_BADQACC, or a joint faster than MAX_SETTLE_SPEED = 100 rad/s or m/s after SETTLE_SECONDS = 1 s.")
 def mujoco_unstable(ctx) -> Iterator[Hit]:
+    from ar3cli.sim.mujoco_session import home_pose
+
     robot, _ = _compiled(ctx)
     if robot is None or not robot.joint_ids:
         return
-    robot.set_positions(_home(ctx))
+    robot.set_positions(home_pose(ctx.model))
     robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
     bad_acceleration = int(robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)].number)
     reported = False
