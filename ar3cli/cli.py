@@ -55,6 +55,7 @@ COMMANDS: dict[str, str] = {
     "fix-mesh-paths": "ar3cli.commands.fix_mesh_paths:fix_mesh_paths",
     "fix-collision": "ar3cli.commands.fix_collision:fix_collision",
     "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",
+    "cross-check": "ar3cli.commands.cross_check:cross_check",
     "diff": "ar3cli.commands.diff:diff",
     "scan": "ar3cli.commands.scan:scan",
     "scan-report": "ar3cli.commands.scan_report:scan_report",

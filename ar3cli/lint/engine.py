@@ -30,6 +30,8 @@ if TYPE_CHECKING:
     from ar3cli.lint.result_cache import ResultCache
 
 ROBOT_SUFFIXES = (".urdf", ".xacro")
+ENGINE_OF = {"P": "pybullet", "M": "mujoco"}
+"""Simulation rule family -> the engine it needs (``--engine``)."""
 _SKIP_DIRS = {".git", ".hg", ".svn", "__pycache__", "node_modules", ".venv", "venv", ".tox"}
 _INLINE = re.compile(r"ar3cli:\s*ignore(?!-file)(?:\[([^\]]*)\])?")
 _FILE_LEVEL = re.compile(rb"ar3cli:\s*ignore-file(?:\[([^\]]*)\])?")
@@ -48,13 +50,16 @@ class LintOptions:
     xacro_args: Mapping[str, str] = field(default_factory=dict)
     srdf_disabled: frozenset[frozenset[str]] = frozenset()
     """Link pairs an SRDF tells MoveIt not to check (``--srdf``): not reported as colliding at home."""
+    engines: tuple[str, ...] = ("pybullet",)
+    """Simulators ``--sim`` runs (``--engine``): P rules need ``pybullet``, M rules ``mujoco`` (or their code named)."""
 
     def rules(self) -> list[Rule]:
         """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
         when ``select`` names their code."""
         named = {code.upper() for code in self.select}
         return [r for r in RULES if matches(r.code, self.select) and not matches(r.code, self.ignore)
-                and (self.sim or not r.needs_sim) and (not r.opt_in or r.code in named)]
+                and (self.sim or not r.needs_sim) and (not r.opt_in or r.code in named)
+                and (not r.needs_sim or ENGINE_OF.get(r.code[0]) in self.engines or r.code in named)]
 
 
 @dataclass
@@ -194,17 +199,22 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
     static = [rule for rule in rules if not rule.needs_sim]
-    simulated = [rule for rule in rules if rule.needs_sim]
+    simulated = [rule for rule in rules if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
+    in_mujoco = [rule for rule in rules if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
     findings = _run_rules(model, shown, static, options)
     error = None
-    if simulated:
+    if simulated or in_mujoco:
         from ar3cli.infra.isolation import CrashError
+        from ar3cli.sim.mujoco_session import run_mujoco
         from ar3cli.sim.session import run_pybullet
 
-        try:
-            findings += run_pybullet(lambda: _run_rules(model, shown, simulated, options), model)
-        except CrashError as exc:
-            error = exc.message
+        for run, selected in ((run_pybullet, simulated), (run_mujoco, in_mujoco)):
+            if not selected:
+                continue
+            try:
+                findings += run(lambda selected=selected: _run_rules(model, shown, selected, options), model)
+            except CrashError as exc:
+                error = exc.message
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
 

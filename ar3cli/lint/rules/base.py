@@ -26,6 +26,7 @@ FAMILIES = {
     "I": "inertia",
     "G": "geometry",
     "P": "sim",
+    "M": "mujoco",
 }
 """Code prefix -> family name; the prefix is the first letter of every code."""
 

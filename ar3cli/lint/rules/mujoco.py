@@ -1,0 +1,159 @@
+"""MuJoCo rules (M, with ``--sim --engine mujoco|all``): compile the model in MuJoCo and see what it does.
+
+The model is compiled once per file (:class:`~ar3cli.sim.mujoco_session.MjRobot`, kept on the lint
+context) from the copy :mod:`ar3cli.sim.mujoco_copy` writes: ``package://`` resolved as for PyBullet,
+meshes MuJoCo cannot read replaced by their boxes (M002) so the rest is still checked. MuJoCo's
+messages name a link or joint ("Element name 'arm'"): the finding points at its line in the user's file.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from typing import Any
+
+from ar3cli.errors import UserError
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+
+SETTLE_SECONDS = 1.0
+MAX_SETTLE_SPEED = 100.0
+"""rad/s or m/s: as P004, a joint faster than this after one second under gravity has exploded."""
+PENETRATION = 1e-6
+"""m: as P002 (``sim.session.PENETRATION_TOLERANCE``), contacts shallower than this are resting faces."""
+_COMPILED = "_ar3cli_mujoco"
+
+
+def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
+    """The file's MjRobot (compiled once, kept on the context), or (None, the compile error)."""
+    if not hasattr(ctx, _COMPILED):
+        from ar3cli.sim.mujoco_session import MjRobot
+
+        try:
+            setattr(ctx, _COMPILED, (MjRobot(ctx.model, fuse=False), None))
+        except UserError as exc:
+            setattr(ctx, _COMPILED, (None, exc))
+    return getattr(ctx, _COMPILED)
+
+
+
+@rule("M001", "mujoco-compile-failed", "error", "MuJoCo refuses to compile the model",
+      why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
+      PyBullet's loader: a moving body whose mass or inertia is below mjMINVAL (a link without <inertial>
+      and without collision geometry), an inertia breaking A + B >= C, a zero joint axis. ar3cli quotes
+      MuJoCo's reason at the link or joint it names.""",
+      fix="Fix the reason quoted in the message (often an I or J finding of the same element).",
+      bad=arm(link_extra=""), good=arm(), needs_sim=True,
+      references="MuJoCo 4.0 user_objects.cc: 'mass and inertia of moving bodies must be larger than mjMINVAL'")
+def mujoco_compile_failed(ctx) -> Iterator[Hit]:
+    from ar3cli.sim.mujoco_session import MujocoCompileError
+
+    robot, error = _compiled(ctx)
+    if error is not None:
+        if isinstance(error, MujocoCompileError):
+            yield Hit(f"MuJoCo cannot compile it: {error.reason}",
+                      error.element if error.element is not None else ctx.model.root)
+        else:
+            yield Hit(error.message.removeprefix(f"{ctx.model.path}: "), ctx.model.root)
+
+
+_DAE = robot(f"""
+    <link name="base">{LINK_INERTIAL}<collision><geometry><mesh filename="part.dae"/></geometry></collision></link>""")
+_STL = robot(f"""
+    <link name="base">{LINK_INERTIAL}<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision></link>""")
+
+
+@rule("M002", "mujoco-mesh-unreadable", "warning", "A collision mesh MuJoCo cannot read",
+      why="""MuJoCo reads STL, OBJ and MSH meshes only: a COLLADA (.dae) collision mesh, or one that is not found,
+      stops its whole compile with "Error opening file". ar3cli replaces the mesh by its bounding box (or leaves
+      it out when its size is unknown) so the other checks still run, and says so here.""",
+      fix="Export the collision mesh as STL or OBJ (keep the .dae for visuals, which MuJoCo discards).",
+      bad=_DAE, good=_STL, needs_sim=True)
+def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
+    robot, error = _compiled(ctx)
+    if robot is None:
+        return
+    for substitution in robot.substitutions:
+        yield Hit(f"link '{substitution.link}': {substitution.reason}; {substitution.replacement} for MuJoCo",
+                  substitution.element)
+
+
+@rule("M003", "mujoco-self-collision-home", "warning", "Links collide in MuJoCo at the home pose",
+      why="""MuJoCo collides every pair of bodies but a parent and its child (no URDF_USE_SELF_COLLISION flag
+      to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
+      starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
+      fixed joints are not reported, as for P002.""",
+      fix="Fix the collision geometry or the joint origin; if the overlap is by design, exclude the pair "
+          "(<contact><exclude> in MJCF, or an SRDF for MoveIt).",
+      bad=robot("""
+        <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+          <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+        <link name="mid"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+          <collision><geometry><box size="0.05 0.05 0.05"/></geometry></collision></link>
+        <link name="tip"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+          <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="mid"/><origin xyz="0 0 0.3"/>
+          <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+        <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 -0.25"/>
+          <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
+      good=arm(), needs_sim=True,
+      thresholds="Deeper than PENETRATION = 1e-6 m, as P002.")
+def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
+    from ar3cli.sim.adjacency import adjacent_pairs, rigid_groups
+    from ar3cli.sim.mujoco_session import home_pose
+    from ar3cli.urdf.srdf import is_disabled
+
+    robot, _ = _compiled(ctx)
+    if robot is None:
+        return
+    robot.set_positions(home_pose(ctx.model))
+    adjacent = adjacent_pairs(ctx.model)
+    group = rigid_groups(ctx.model, robot.joint_ids)
+    for a, b, depth in robot.contacts(PENETRATION):
+        if frozenset((a, b)) in adjacent or is_disabled(ctx.srdf_disabled, a, b) or \
+                (a in group and group[a] == group.get(b)):
+            continue
+        link = ctx.model.link(b) or ctx.model.link(a)
+        yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.3g} mm at the home pose in MuJoCo",
+                  link.element if link else None)
+
+
+@rule("M004", "mujoco-unstable", "error", "NaN or exploding states in MuJoCo after 1 s under gravity",
+      why="""ar3cli compiles the model (root welded to the world), puts it at the home pose and simulates one
+      second under gravity with MuJoCo's default timestep (2 ms). A real robot falls limp; NaN positions,
+      MuJoCo's own instability warning (mjWARN_BADQACC) or joint speeds above 100 rad/s mean an inertia too
+      small for the timestep, a degenerate mass, or a negative joint damping (which MuJoCo applies and
+      PyBullet ignores).""",
+      fix="Look at the I and J findings for this file (inertia, mass, a negative <dynamics damping>); fix-inertia "
+          "often cures it.",
+      bad=arm(link_extra='<inertial><origin xyz="0.5 0 0"/><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" '
+                         'iyy="0.01" iyz="0" izz="0.01"/></inertial>',
+              joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><dynamics damping="-50"/>'
+              ).replace('<axis xyz="0 0 1"/>', '<axis xyz="0 1 0"/>'),
+      good=arm(), needs_sim=True,
+      thresholds="NaN, mjWARN_BADQACC, or a joint faster than MAX_SETTLE_SPEED = 100 rad/s or m/s after SETTLE_SECONDS = 1 s.")
+def mujoco_unstable(ctx) -> Iterator[Hit]:
+    from ar3cli.sim.mujoco_session import home_pose
+
+    robot, _ = _compiled(ctx)
+    if robot is None or not robot.joint_ids:
+        return
+    robot.set_positions(home_pose(ctx.model))
+    robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
+    bad_acceleration = int(robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)].number)
+    reported = False
+    for name, (position, velocity) in zip(robot.joint_ids, robot.joint_states(list(robot.joint_ids))):
+        joint = ctx.model.joint(name)
+        element = joint.element if joint is not None else None
+        if not (math.isfinite(position) and math.isfinite(velocity)):
+            reported = True
+            yield Hit(f"joint '{name}' state is NaN/inf after {SETTLE_SECONDS:g} s under gravity in MuJoCo", element)
+        elif abs(velocity) > MAX_SETTLE_SPEED:
+            reported = True
+            yield Hit(f"joint '{name}' moves at {velocity:.3g} after {SETTLE_SECONDS:g} s under gravity in MuJoCo",
+                      element)
+    if bad_acceleration and not reported:
+        yield Hit(f"MuJoCo reported {bad_acceleration} unstable step(s) (bad acceleration; the simulation was reset)",
+                  ctx.model.root)
+
+
+RULES = (mujoco_compile_failed, mujoco_mesh_unreadable, mujoco_self_collision_home, mujoco_unstable)
