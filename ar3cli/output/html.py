@@ -54,8 +54,11 @@ def lint_page(data: Mapping[str, Any], context: Mapping[str, Any]) -> str:
     findings = list(data.get("findings", []))
     fixes = list(context.get("fixes", []))
     body = ["<h1>ar3cli lint-urdf</h1>", f"<p>{esc(context.get('verdict', ''))}</p>", severity_counts(summary)]
+    start = 0
     for at, result in enumerate(data.get("files", [])):
-        mine = [index for index, finding in enumerate(findings) if finding.get("path") == result.get("path")]
+        # each file's findings follow the previous file's (their path may be an included xacro file)
+        mine = list(range(start, min(start + int(result.get("findings", 0)), len(findings))))
+        start = mine[-1] + 1 if mine else start
         error = f'<p>{badge("error")} not fully checked: {esc(result["error"])}</p>' if result.get("error") else ""
         own = {"sources": context.get("sources", {}), "fixes": [fixes[i] if i < len(fixes) else "" for i in mine]}
         body.append(f'<section id="file-{at}" data-findings="{int(result.get("findings", 0))}"><h2 class="mono">'

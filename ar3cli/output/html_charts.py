@@ -42,7 +42,7 @@ def heat_map_svg(collisions: Mapping[str, Any]) -> str:
     cell = max(3, min(18, MAX_MATRIX_PX // count))
     font = max(5, min(11, cell - 2))
     size = LABEL_PX + cell * count
-    parts = [f'<svg class="heat" xmlns="http://www.w3.org/2000/svg" width="{size + 10}" height="{size + 10}" '
+    parts = [f'<svg class="heat" width="{size + 10}" height="{size + 10}" '
              f'viewBox="0 0 {size + 10} {size + 10}" role="img" aria-label="self-collision matrix">']
     for at, name in enumerate(links):
         y = LABEL_PX + at * cell + cell * 0.75
@@ -98,7 +98,7 @@ def torque_chart_svg(torques: Mapping[str, Any]) -> str:
     height = ROW_PX * len(joints) + 30
     width = NAME_PX + BAR_PX + 330
     limit_x = NAME_PX + BAR_PX / 2
-    parts = [f'<svg xmlns="http://www.w3.org/2000/svg" width="{width}" height="{height}" viewBox="0 0 {width} {height}" '
+    parts = [f'<svg width="{width}" height="{height}" viewBox="0 0 {width} {height}" '
              'role="img" aria-label="gravity torque against declared effort per joint">',
              f'<text x="{NAME_PX}" y="12" font-size="11">0%</text>'
              f'<text x="{limit_x - 12:.0f}" y="12" font-size="11">100% of effort</text>'

@@ -104,7 +104,7 @@ def page(title: str, body: Iterable[str], data: Mapping[str, Any]) -> str:
     """The whole document: head (CSP, CSS), ``body`` parts, the data island and the script."""
     return "".join([
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">",
-        f'<meta http-equiv="Content-Security-Policy" content="{esc(CSP)}">',
+        f'<meta http-equiv="Content-Security-Policy" content="{CSP}">',
         '<meta name="viewport" content="width=device-width,initial-scale=1">',
         f"<title>{esc(title)}</title><style>{CSS}</style></head><body>\n",
         *body,
