@@ -329,7 +329,7 @@ def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool 
         document = junit_document([(r.path, r.findings, r.error) for r in results], Severity(summary["fail_on"]))
         return Report(data=data, text=document, lines=[summary_line(summary)], ok=ok)
     if fmt is LintFormat.html:
-        from ar3cli.commands.report import finding_context
+        from ar3cli.commands.finding_context import finding_context
         from ar3cli.output.html import lint_page
 
         page = lint_page(data, {"verdict": summary_line(summary), **finding_context(findings)})

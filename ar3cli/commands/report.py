@@ -10,7 +10,7 @@ A section that cannot be computed (no collision geometry, a pybullet crash) says
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Any, TypeVar
 
@@ -64,6 +64,7 @@ def report(
     JSON documents of info --torques, lint-urdf, sample-collisions and fk-verify for the same
     --samples and --seed.
     """
+    from ar3cli.commands.finding_context import finding_context
     from ar3cli.infra.atomic import atomic_write, check_writable
     from ar3cli.output.html import robot_page
     from ar3cli.urdf.loading import load_with_specs
@@ -181,31 +182,3 @@ def _fk(model, path: Path, samples: int, seed: int) -> tuple[dict, list[str]]:
     made = fk_report(model, path, samples, seed, Tolerance(DEFAULT_TOLERANCE_M, 1e-6, scaled=True), drawn,
                      comparison, None)
     return made.data, made.lines
-
-
-LONGEST_SOURCE_LINE = 240
-"""Characters of a cited line shown (a one-line minified file must not copy itself per finding)."""
-
-
-def finding_context(findings: Iterable) -> dict[str, Any]:
-    """What the page shows with each finding: the cited lines of its source file (the xacro file it
-    came from; ``sources[path][line]``) and the ar3cli command that fixes it (``fixes[index]``)."""
-    from ar3cli.infra.safe_read import read_bytes
-    from ar3cli.lint.fix_hints import fix_commands
-    from ar3cli.output.html_page import SOURCE_CONTEXT
-
-    findings = list(findings)
-    wanted: dict[str, set[int]] = {}
-    for finding in findings:
-        if finding.line:
-            wanted.setdefault(finding.path, set()).update(range(finding.line - SOURCE_CONTEXT,
-                                                                finding.line + SOURCE_CONTEXT + 1))
-    sources: dict[str, dict[int, str]] = {}
-    for name, numbers in wanted.items():
-        try:
-            text = read_bytes(Path(name)).decode("utf-8", errors="replace").splitlines()
-        except UserError:
-            continue
-        sources[name] = {n: text[n - 1][:LONGEST_SOURCE_LINE] for n in sorted(numbers) if 1 <= n <= len(text)}
-    fixes = [(fix_commands(f.path, [f]) or [""])[0] for f in findings]
-    return {"sources": sources, "fixes": fixes}
