@@ -59,6 +59,7 @@ COMMANDS: dict[str, str] = {
     "diff": "ar3cli.commands.diff:diff",
     "scan": "ar3cli.commands.scan:scan",
     "scan-report": "ar3cli.commands.scan_report:scan_report",
+    "report": "ar3cli.commands.report:report",
 }
 """Every command, in the order ``--help`` lists them, and where its function is. A run imports
 only the module of the command it runs (see :func:`application`)."""

@@ -29,6 +29,7 @@ class LintFormat(str, enum.Enum):
     github = "github"
     markdown = "markdown"
     junit = "junit"
+    html = "html"
 
 
 class Engine(str, enum.Enum):
@@ -347,6 +348,12 @@ def render_lint(results, summary: dict, options, fmt: LintFormat, grouped: bool 
 
         document = junit_document([(r.path, r.findings, r.error) for r in results], Severity(summary["fail_on"]))
         return Report(data=data, text=document, lines=[summary_line(summary)], ok=ok)
+    if fmt is LintFormat.html:
+        from ar3cli.commands.finding_context import finding_context
+        from ar3cli.output.html import lint_page
+
+        page = lint_page(data, {"verdict": summary_line(summary), **finding_context(findings)})
+        return Report(data=data, text=page, lines=[summary_line(summary)], ok=ok)
     if fmt in (LintFormat.github, LintFormat.markdown):
         from ar3cli.output.github import annotation, append_step_summary, markdown_table
 

@@ -1,0 +1,184 @@
+"""``ar3cli report``: one self-contained HTML page per robot.
+
+Features never import each other, so this command module is where the page's data is gathered:
+it calls each feature the way its own command does (info, lint-urdf, render, sample-collisions,
+fk-verify) and hands the plain results (their JSON documents, summary lines, PNG bytes) to
+:mod:`ar3cli.output.html`, which only renders. The JSON documents on the page are built by the
+same functions as those commands' ``--format json``, so the numbers are equal by construction.
+A section that cannot be computed (no collision geometry, a pybullet crash) says why on the page.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Annotated, Any, TypeVar
+
+import typer
+
+from ar3cli.commands.options import (
+    FollowSymlinksOption,
+    FormatOption,
+    PackagePathOption,
+    RobotPathArgument,
+    SeedOption,
+    TimeoutOption,
+    XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
+    samples_option,
+)
+from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
+from ar3cli.output.report import OutputFormat, Report, finish, log
+
+T = TypeVar("T")
+VIEWS = (("front", 0.0, -10.0), ("side", 90.0, -10.0), ("top", 0.0, -89.0))
+"""(name, camera yaw, camera pitch) of the three pictures, each drawn with the visual and the collision geometry."""
+PICTURE_SIZE = (360, 300)
+SamplesOption = Annotated[int, samples_option(
+    "Random configurations for the collision matrix, the torque check and fk-verify (small by default: "
+    "a page, not a study; sample-collisions defaults to 10000).", most=100_000)]
+
+
+def report(
+    path: RobotPathArgument,
+    output: Annotated[Path, typer.Option("--output", "-o", metavar="FILE.html", dir_okay=False,
+                                         help="The HTML file to write.", show_default=False)],
+    samples: SamplesOption = 100,
+    seed: SeedOption = 0,
+    follow_symlinks: FollowSymlinksOption = False,
+    package_path: PackagePathOption = None,
+    xacro_arg: XacroArgOption = None,
+    xacro: XacroModeOption = XacroMode.safe,
+    xacro_env: XacroEnvOption = None,
+    format: FormatOption = OutputFormat.text,
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
+) -> None:
+    """Write one self-contained HTML page about a robot: summary, kinematic tree, pictures from three
+    sides (visual and collision, contacts at home in red), lint findings with their source lines
+    and fix commands, the self-collision heat map, torque margins and fk-verify's verdict.
+
+    The page works offline and loads nothing (inline CSS, JS and pictures). Its data island holds the
+    JSON documents of info --torques, lint-urdf, sample-collisions and fk-verify for the same
+    --samples and --seed.
+    """
+    from ar3cli.commands.finding_context import finding_context
+    from ar3cli.infra.atomic import atomic_write, check_writable
+    from ar3cli.output.html import robot_page
+    from ar3cli.urdf.loading import load_with_specs
+
+    output = check_writable(output, follow_symlinks)
+    data: dict[str, Any] = {"settings": {"samples": samples, "seed": seed,
+                                         "described": f"{samples} samples, seed {seed}"}, "skipped": {},
+                            "cross_check": None}  # the hook: cross-check's JSON document once it exists
+    lines: dict[str, list[str]] = {}
+    data["lint"], findings = lint_document(path, package_path, xacro_arg)
+    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
+    data["info"], lines["info"], lines["torques"] = _info(model, samples, seed, data["skipped"])
+    pictures = _pictures(model, lines.setdefault("pictures", []))
+    data["renders"] = [{key: value for key, value in p.items() if key != "png"} for p in pictures]
+    data["collisions"], lines["collisions"] = _attempt(lambda: _collisions(model, samples, seed),
+                                                       "collisions", data["skipped"])
+    data["fk"], lines["fk"] = _attempt(lambda: _fk(model, path, samples, seed), "fk", data["skipped"])
+    context = {"lines": lines, **finding_context(findings)}
+    document = robot_page(data, context, pictures).encode("utf-8")
+    atomic_write(output, document)
+    summary = data["lint"]["summary"]
+    finish(Report(data={"path": str(output), "bytes": len(document), "lint": summary, "skipped": data["skipped"]},
+                  lines=[f"wrote {output} ({len(document) / 1024:.0f} KB): {summary['error']} errors, "
+                         f"{summary['warning']} warnings, {summary['info']} info"]
+                  + [f"not on the page: {key}: {why}" for key, why in data["skipped"].items()]), format)
+
+
+def _attempt(work: Callable[[], tuple[T, list[str]]], key: str, skipped: dict[str, str]) -> tuple[T | None, list[str]]:
+    """Run one section's work; a UserError (nothing to check, pybullet crashed) leaves it out with its reason."""
+    try:
+        return work()
+    except UserError as exc:
+        skipped[key] = exc.message
+        log(f"report: {key} left out: {exc.message}")
+        return None, []
+
+
+def lint_document(path: Path, package_path: list[str] | None, xacro_arg: list[str] | None) -> tuple[dict, list]:
+    """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
+    and the findings."""
+    from ar3cli.commands.lint_urdf import LintFormat, render_lint
+    from ar3cli.errors import EXIT_USAGE
+    from ar3cli.findings import Severity
+    from ar3cli.lint.config import load_config
+    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
+    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.urdf.xacro_expand import parse_xacro_args
+
+    config = load_config()
+    try:
+        options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
+                              per_file_ignores=config.per_file_ignores, severity=config.severity,
+                              package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    results = lint_paths([path], options)
+    summary = summarize(results, config.fail_on or Severity.ERROR)
+    summary["exit_code"] = EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] else 0
+    return render_lint(results, summary, options, LintFormat.json).data, [f for r in results for f in r.findings]
+
+
+def _info(model, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict, list[str], list[str]]:
+    """``info --torques --samples N --seed S --format json``'s document, its summary and torque lines."""
+    from ar3cli.info.summary import summarize
+    from ar3cli.info.text import report, summary_lines, torque_lines
+    from ar3cli.info.torques import gravity_torques
+    from ar3cli.kinematics.fk import urdf_link_frames
+
+    summary = summarize(model, lambda m: {link: f[0] for link, f in urdf_link_frames(m, {}, 1).items()})
+    torques, _ = _attempt(lambda: (gravity_torques(model, samples, seed), []), "torques", skipped)
+    document = report(summary, tree=False, torques=torques).data
+    return document, summary_lines(summary), torque_lines(torques) if torques is not None else []
+
+
+def _pictures(model, notes: list[str]) -> list[dict[str, Any]]:
+    """Three sides, visual then collision geometry (render's own drawing: contacts at home in red)."""
+    import tempfile
+
+    from ar3cli.pictures.render import draw_robot
+
+    pictures = []
+    with tempfile.TemporaryDirectory(prefix="ar3cli-report-") as folder:
+        for geometry in ("visual", "collision"):
+            for side, yaw, pitch in VIEWS:
+                target = Path(folder) / f"{geometry}-{side}.png"
+                entry: dict[str, Any] = {"side": side, "geometry": geometry}
+                try:
+                    drawn = draw_robot(model, target, None, *PICTURE_SIZE, yaw_deg=yaw, pitch_deg=pitch,
+                                       show_collision=geometry == "collision", warn=notes.append)
+                    entry.update(drawn.to_dict(), png=target.read_bytes())
+                    del entry["path"]
+                except UserError as exc:
+                    entry["error"] = exc.message
+                pictures.append(entry)
+                if entry.get("error") and geometry == "visual":
+                    break  # the same reason for the other sides
+    return pictures
+
+
+def _collisions(model, samples: int, seed: int) -> tuple[dict, list[str]]:
+    """``sample-collisions --samples N --seed S --format json``'s document and summary lines."""
+    from ar3cli.collisions.report import matrix_report
+    from ar3cli.collisions.run import sample_matrix
+
+    made = matrix_report(model, sample_matrix(model, samples, seed, None, 0.95), OutputFormat.text)
+    return made.data, made.lines
+
+
+def _fk(model, path: Path, samples: int, seed: int) -> tuple[dict, list[str]]:
+    """``fk-verify --samples N --seed S --format json``'s document and its verdict lines."""
+    from ar3cli.commands.fk_verify import DEFAULT_TOLERANCE_M
+    from ar3cli.kinematics.verify import Tolerance, fk_report, measure
+
+    drawn, comparison = measure(model, samples, seed, announce=False)
+    made = fk_report(model, path, samples, seed, Tolerance(DEFAULT_TOLERANCE_M, 1e-6, scaled=True), drawn,
+                     comparison, None)
+    return made.data, made.lines
