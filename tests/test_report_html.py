@@ -9,6 +9,7 @@ Set ``AR3CLI_REPORT_SCREENSHOT=docs/images/report.png`` to save the AR3 page's s
 from __future__ import annotations
 
 import html.parser
+import importlib.util
 import json
 import os
 import re
@@ -104,7 +105,8 @@ def test_robot_strings_are_escaped(pages):
 
 
 def test_numbers_equal_the_json_outputs(pages):
-    """The island holds what info, lint-urdf, sample-collisions and fk-verify print with --format json."""
+    """The island holds what info, lint-urdf, sample-collisions, fk-verify and (MuJoCo installed) cross-check
+    print with --format json."""
     island = _island(pages["ar3"].read_text(encoding="utf-8"))
     common = ("--samples", SAMPLES, "--seed", SEED)
     assert island["info"] == _json("info", str(AR3), "--torques", *common)
@@ -115,7 +117,12 @@ def test_numbers_equal_the_json_outputs(pages):
     assert {k: v for k, v in island["collisions"].items() if k not in timing} == \
         {k: v for k, v in collisions.items() if k not in timing}
     assert island["fk"] == _json("fk-verify", str(AR3), *common)
-    assert island["cross_check"] is None
+    if importlib.util.find_spec("mujoco") is None:
+        assert island["cross_check"] is None
+    else:
+        cross = _json("cross-check", str(AR3), *common)
+        assert {k: v for k, v in island["cross_check"].items() if k not in ("passed", "lines")} == cross
+        assert island["cross_check"]["passed"] is cross["agree"]
 
 
 def test_findings_carry_source_lines_and_fixes(pages):

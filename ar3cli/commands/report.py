@@ -72,7 +72,7 @@ def report(
     output = check_writable(output, follow_symlinks)
     data: dict[str, Any] = {"settings": {"samples": samples, "seed": seed,
                                          "described": f"{samples} samples, seed {seed}"}, "skipped": {},
-                            "cross_check": None}  # the hook: cross-check's JSON document once it exists
+                            "cross_check": None}
     lines: dict[str, list[str]] = {}
     data["lint"], findings = lint_document(path, package_path, xacro_arg)
     model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
@@ -82,6 +82,8 @@ def report(
     data["collisions"], lines["collisions"] = _attempt(lambda: _collisions(model, samples, seed),
                                                        "collisions", data["skipped"])
     data["fk"], lines["fk"] = _attempt(lambda: _fk(model, path, samples, seed), "fk", data["skipped"])
+    data["cross_check"], lines["cross_check"] = _attempt(lambda: _cross_check(model, path, samples, seed),
+                                                         "cross_check", data["skipped"])
     context = {"lines": lines, **finding_context(findings)}
     document = robot_page(data, context, pictures).encode("utf-8")
     atomic_write(output, document)
@@ -162,6 +164,19 @@ def _pictures(model, notes: list[str]) -> list[dict[str, Any]]:
                 if entry.get("error") and geometry == "visual":
                     break  # the same reason for the other sides
     return pictures
+
+
+def _cross_check(model, path: Path, samples: int, seed: int) -> tuple[dict | None, list[str]]:
+    """``cross-check --format json``'s document (with ``passed`` and its ``lines``) where MuJoCo is
+    installed (the ``mujoco`` extra); None, and the page says how to get it, where it is not."""
+    import importlib.util
+
+    if importlib.util.find_spec("mujoco") is None:
+        return None, []
+    from ar3cli.cross_check.run import cross_check
+
+    made = cross_check(model, path, samples, seed, announce=False)
+    return {**made.data, "passed": made.ok, "lines": made.lines}, made.lines
 
 
 def _collisions(model, samples: int, seed: int) -> tuple[dict, list[str]]:

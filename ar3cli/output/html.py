@@ -173,10 +173,11 @@ def _fk(fk: Mapping[str, Any] | None, lines: Sequence[str], why: str | None) -> 
 
 
 def _cross_check(result: Mapping[str, Any] | None) -> str:
-    """The hook for ``cross-check``'s verdict: the command puts its JSON document in
-    ``data["cross_check"]`` (``passed`` and ``lines``) once that feature exists."""
+    """``cross-check``'s verdict: the command puts its JSON document in ``data["cross_check"]``
+    (``passed`` and ``lines``), or None where MuJoCo is not installed."""
     if not result:
-        return '<p class="muted">not available in this version of ar3cli.</p>'
+        return ('<p class="muted">MuJoCo is not installed here: <code>pip install \'ar3cli[mujoco]\'</code> '
+                'adds PyBullet-against-MuJoCo agreement to this page.</p>')
     verdict = '<span class="badge ok">\u2714 PASS</span>' if result.get("passed") else \
         '<span class="badge fail">\u2716 FAIL</span>'
     return f"<p>{verdict}</p>" + _lines([str(line) for line in result.get("lines", [])])
