@@ -158,7 +158,8 @@ def detached_child(ctx) -> Iterator[Hit]:
         if gap > max(DETACHED_MIN_GAP, DETACHED_FACTOR * size):
             yield Hit(f"link '{link.name}' sits {gap:.3g} m away from link '{ancestor.name}' (parts about "
                       f"{size:.3g} m across) at the home pose: joint '{joint.name}' origin "
-                      f"xyz=\"{' '.join(f'{v:g}' for v in joint.origin.xyz)}\" looks wrong", joint.element)
+                      f"xyz=\"{' '.join(f'{v:g}' for v in joint.origin.xyz)}\" looks wrong",
+                      joint.origin.element if joint.origin.element is not None else joint.element)
 
 
 def _overlap_fraction(inner: Box, outer: Box) -> float:

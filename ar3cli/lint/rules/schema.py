@@ -202,7 +202,7 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
             if name in attrs or name in extra or _local(name) is None:
                 continue
             guess = _closest(name, attrs)
-            if guess is None or guess in element.attrib:
+            if guess is None or (guess in element.attrib and name not in INERTIA_SYMMETRY):
                 continue  # an extension's attribute (command_effort, dont_collapse, twist), not a misspelling
             yield Hit(f"{_owner(element)} has an unknown attribute {name}=\"{element.get(name)}\" (did you mean "
                       f"{guess}?): {WHAT_PARSERS_DO}", element, hint=f"Rename {name}= to {guess}=.")
