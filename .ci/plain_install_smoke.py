@@ -131,8 +131,9 @@ def main() -> int:
         work = Path(folder)
         smoke = Smoke(args.ar3cli, work)
         steps(smoke, work)
-        print(f"plain-install smoke: {smoke.count - len(smoke.failures)}/{smoke.count} steps passed"
-              + (f"; failed: {', '.join(smoke.failures)}" if smoke.failures else ""))
+        if smoke.failures:
+            print(f"plain-install smoke: failed: {', '.join(smoke.failures)}")
+        print(f"smoke: {smoke.count - len(smoke.failures)} passed, {len(smoke.failures)} failed")
         return 1 if smoke.failures else 0
 
 
@@ -158,6 +159,17 @@ def steps(smoke: Smoke, work: Path) -> None:
         smoke.run(name, ["render", str(robot), "--output", str(png), "--width", "160", "--height", "120", *extra],
                   check=lambda r, png=png: None if is_png(png) else "no PNG written")
     smoke.run("grasp-demo", ["grasp-demo"], expect=(0, 1))
+    smoke.run("diff (no change)", ["diff", str(robot), str(robot), "--samples", "5"])
+    smoke.run("report", ["report", str(robot), "-o", str(work / "robot.html"), "--samples", "20"],
+              check=lambda r: None if (work / "robot.html").read_bytes().startswith(b"<!DOCTYPE html>")
+              else "no HTML page written")
+    smoke.run("scan", ["scan", str(robot.parent), "--store", str(work / "scan.sqlite"), "--format", "json"],
+              expect=(0, 1), check=lambda r: None if json_of(r) else "no JSON")
+    smoke.run("scan-report", ["scan-report", str(work / "scan.sqlite"), "--format", "json"],
+              check=lambda r: None if json_of(r) else "no JSON")
+    for name, args in (("cross-check (no mujoco)", ["cross-check", str(robot)]),
+                       ("lint-urdf --engine mujoco (no mujoco)", ["lint-urdf", "--sim", "--engine", "mujoco", str(robot)])):
+        smoke.run(name, args, expect=(2,), check=needs("pip install 'ar3cli[mujoco]'"))
 
     def fixed_copy(name: str) -> Path:
         return make_robot(work / name)

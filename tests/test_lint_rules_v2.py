@@ -452,7 +452,7 @@ def test_metadata_reaches_the_docs_and_the_rule_object():
     assert "**References.** MuJoCo include/mujoco/mjtnum.h" in text
     assert REGISTRY["J006"].fixed_by == "fix-continuous"
     codes = [r.code for r in RULES]
-    assert codes == sorted(codes, key=lambda c: ("FSJIGPM".index(c[0]), c))
+    assert codes == sorted(codes, key=lambda c: ("FSJIGPMT".index(c[0]), c))
 
 
 # ---- J005 and J003/J014 on virtual base joints and PyBullet's "no limit" idiom (issue 30) ----------

@@ -121,6 +121,10 @@ def lint_urdf(
         help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
     = None,
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
+    target: Annotated[Optional[list[str]], typer.Option(
+        "--target", metavar="ENGINES",
+        help="Engines the robot is meant for (comma-separated or repeated: pybullet, ros, mujoco, isaac, drake, "
+             "gazebo): adds each one's known traps (T rules). Default: pybullet,ros.", show_default=False)] = None,
 ) -> None:
     """Check URDF and xacro files for mistakes that break ROS tools or make PyBullet misbehave.
 
@@ -158,7 +162,7 @@ def lint_urdf(
             ignore=[*config.ignore, *validate_patterns(_split(ignore), "--ignore")],
             per_file_ignores=config.per_file_ignores, severity=config.severity, sim=sim,
             package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg),
-            srdf_disabled=_srdf_disabled(srdf, sim), engines=engines)
+            srdf_disabled=_srdf_disabled(srdf, sim), engines=engines, targets=_targets(target))
     except ValueError as exc:
         raise UserError(str(exc)) from None
     apply_xacro_options(xacro is XacroMode.trusted, xacro_env)
@@ -215,6 +219,19 @@ def lint_urdf(
     report.wide = wide
     report.errors = [*report.errors, *(result.error for result in results if result.error)]
     finish(report, "json" if fmt in (LintFormat.json, LintFormat.sarif) else "text")
+
+
+def _targets(values: list[str] | None) -> tuple[str, ...]:
+    """The --target engines, validated (default: pybullet and ros)."""
+    from ar3cli.lint.rules.targets import DEFAULT_TARGETS, TARGETS
+
+    if not values:
+        return DEFAULT_TARGETS
+    names = tuple(dict.fromkeys(name.strip().lower() for value in values for name in value.split(",") if name.strip()))
+    unknown = [name for name in names if name not in TARGETS]
+    if unknown:
+        raise UserError(f"--target: unknown engine {unknown[0]!r} (known: {', '.join(TARGETS)})")
+    return names
 
 
 def _srdf_disabled(srdf: Path | None, sim: bool) -> frozenset[frozenset[str]]:

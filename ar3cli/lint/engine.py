@@ -52,14 +52,17 @@ class LintOptions:
     """Link pairs an SRDF tells MoveIt not to check (``--srdf``): not reported as colliding at home."""
     engines: tuple[str, ...] = ("pybullet",)
     """Simulators ``--sim`` runs (``--engine``): P rules need ``pybullet``, M rules ``mujoco`` (or their code named)."""
+    targets: tuple[str, ...] = ("pybullet", "ros")
+    """Engines the robot is meant for (``--target``): their T rules run."""
 
     def rules(self) -> list[Rule]:
         """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
-        when ``select`` names their code."""
+        when ``select`` names their code; target rules only for the ``targets`` (or when named)."""
         named = {code.upper() for code in self.select}
         return [r for r in RULES if matches(r.code, self.select) and not matches(r.code, self.ignore)
                 and (self.sim or not r.needs_sim) and (not r.opt_in or r.code in named)
-                and (not r.needs_sim or ENGINE_OF.get(r.code[0]) in self.engines or r.code in named)]
+                and (not r.needs_sim or ENGINE_OF.get(r.code[0]) in self.engines or r.code in named)
+                and (not r.targets or set(r.targets) & set(self.targets) or r.code in named)]
 
 
 @dataclass

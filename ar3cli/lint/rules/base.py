@@ -27,6 +27,7 @@ FAMILIES = {
     "G": "geometry",
     "P": "sim",
     "M": "mujoco",
+    "T": "targets",
 }
 """Code prefix -> family name; the prefix is the first letter of every code."""
 
@@ -77,6 +78,8 @@ class Rule:
     thresholds: str | None = None
     references: str | None = None
     opt_in: bool = False
+    targets: tuple[str, ...] = ()
+    """The engines (``lint-urdf --target``) whose traps this rule reports; empty for every engine."""
 
     @property
     def family(self) -> str:
@@ -90,7 +93,8 @@ class Rule:
 
 def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str, bad: str, good: str,
          needs_sim: bool = False, fixed_by: str | None = None, thresholds: str | None = None,
-         references: str | None = None, opt_in: bool = False) -> Callable[[Check | None], Rule]:
+         references: str | None = None, opt_in: bool = False,
+         targets: tuple[str, ...] = ()) -> Callable[[Check | None], Rule]:
     """Decorator turning a check function into a :class:`Rule` (the function's name is unused)."""
 
     def wrap(check: Check | None) -> Rule:
@@ -99,7 +103,8 @@ def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str,
                     bad=textwrap.dedent(bad).strip() + "\n", good=textwrap.dedent(good).strip() + "\n",
                     check=check, needs_sim=needs_sim, fixed_by=fixed_by,
                     thresholds=" ".join(thresholds.split()) if thresholds else None,
-                    references=" ".join(references.split()) if references else None, opt_in=opt_in)
+                    references=" ".join(references.split()) if references else None, opt_in=opt_in,
+                    targets=targets)
 
     return wrap
 

@@ -1,0 +1,272 @@
+"""Geometric consistency rules (G014-G016): where the parts sit relative to each other, from the boxes
+ar3cli already reads (:mod:`ar3cli.urdf.bounds`): no mesh triangles, no simulator.
+
+A joint origin typed 3 m (or 0.8 m) off, a collision pasted 0.3 m away from its visual, a hinge axis
+that misses its part: every parser loads such a file and the robot flies apart, collides where
+nothing is drawn, or swings about thin air (fusion2urdf #42/#50, kuka_experimental #191).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
+from ar3cli.urdf.bounds import Box, shape_bounds
+
+DETACHED_FACTOR = 1.0
+"""A child's box further from its parent's box than this many times the larger of the two box
+diagonals (and than :data:`DETACHED_MIN_GAP`) is detached (G014)."""
+DETACHED_MIN_GAP = 0.25
+"""m: gaps below this are never reported (a sensor on a short bracket, a finger pad)."""
+MAX_WALK = 8
+"""Links without geometry G014 walks up through to find the nearest part with geometry."""
+MAX_SIBLINGS = 16
+"""Siblings (other children of the same part) a detached candidate is also compared with."""
+COVER_MIN = 0.2
+"""Fraction of the visual box the collision box must cover (G015)."""
+OFFSET_FACTOR = 1.0
+"""G015 also needs the boxes' centres apart by this many visual half-diagonals..."""
+OFFSET_MIN = 0.05
+"""... and by at least this many metres."""
+AXIS_FACTOR = 1.0
+"""G016: a hinge axis further from its part's box than this many box diagonals..."""
+AXIS_MIN = 0.1
+"""... and than this many metres misses the part."""
+
+
+def _union(boxes) -> Box | None:
+    boxes = [b for b in boxes if b is not None and all(map(math.isfinite, (*b[0], *b[1])))]
+    if not boxes:
+        return None
+    lows, highs = zip(*boxes)
+    return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]
+
+
+def _diagonal(box: Box) -> float:
+    return math.dist(box[0], box[1])
+
+
+def _gap(a: Box, b: Box) -> float:
+    """Distance between two axis-aligned boxes (0 when they touch or overlap)."""
+    return math.sqrt(sum(max(0.0, b[0][i] - a[1][i], a[0][i] - b[1][i]) ** 2 for i in range(3)))
+
+
+def _moved(box: Box, rotation, translation) -> Box:
+    """The axis-aligned box around ``box`` rotated by ``rotation`` (rows) and moved by ``translation``."""
+    centre = [(lo + hi) / 2 for lo, hi in zip(*box)]
+    half = [(hi - lo) / 2 for lo, hi in zip(*box)]
+    c = [sum(r * v for r, v in zip(row, centre)) + t for row, t in zip(rotation, translation)]
+    h = [sum(abs(r) * v for r, v in zip(row, half)) for row in rotation]
+    return tuple(a - b for a, b in zip(c, h)), tuple(a + b for a, b in zip(c, h))  # type: ignore[return-value]
+
+
+def _compose(outer, inner):
+    """(R, t) of ``outer`` applied after ``inner``: x -> R_o (R_i x + t_i) + t_o."""
+    (ro, to), (ri, ti) = outer, inner
+    rotation = tuple(tuple(sum(ro[i][k] * ri[k][j] for k in range(3)) for j in range(3)) for i in range(3))
+    translation = tuple(sum(ro[i][k] * ti[k] for k in range(3)) + to[i] for i in range(3))
+    return rotation, translation
+
+
+def _joint_transform(joint):
+    return joint.origin.rotation, joint.origin.xyz
+
+
+def _finite_origin(joint) -> bool:
+    return all(map(math.isfinite, (*joint.origin.xyz, *(v for row in joint.origin.rotation for v in row))))
+
+
+def _geometric_ancestor(ctx, link):
+    """(ancestor link, its box, transform from ``link``'s frame to the ancestor's, the first joint) for
+    the nearest ancestor with a known box, or None (at home: every joint at 0)."""
+    model = ctx.model
+    joint = model.parent_joint(link.name)
+    first = joint
+    transform = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0)), (0.0, 0.0, 0.0)
+    for _ in range(MAX_WALK):
+        if joint is None or joint.parent is None or not _finite_origin(joint):
+            return None
+        transform = _compose(_joint_transform(joint), transform)
+        parent = model.link(joint.parent)
+        if parent is None:
+            return None
+        box = ctx.link_bounds(parent)
+        if box is not None:
+            return parent, box, transform, first
+        joint = model.parent_joint(parent.name)
+    return None
+
+
+def detachment(ctx, link) -> tuple[float, float, object, object] | None:
+    """(gap in metres, the size it is compared with, the ancestor, the joint) for a link with a box,
+    or None when there is nothing to compare with. The gap is the smallest distance from the link's
+    box to its nearest geometric ancestor's box or to a sibling's box (other children of that ancestor)."""
+    box = ctx.link_bounds(link)
+    if box is None:
+        return None
+    found = _geometric_ancestor(ctx, link)
+    if found is None:
+        return None
+    ancestor, ancestor_box, transform, joint = found
+    moved = _moved(box, *transform)
+    gap = _gap(moved, ancestor_box)
+    size = max(_diagonal(box), _diagonal(ancestor_box))
+    if gap <= max(DETACHED_MIN_GAP, DETACHED_FACTOR * size):
+        return gap, size, ancestor, joint
+    for sibling_joint in ctx.model.child_joints(ancestor.name)[:MAX_SIBLINGS]:
+        sibling = ctx.model.link(sibling_joint.child) if sibling_joint.child else None
+        if sibling is None or sibling is link or not _finite_origin(sibling_joint):
+            continue
+        sibling_box = ctx.link_bounds(sibling)
+        if sibling_box is not None:
+            gap = min(gap, _gap(moved, _moved(sibling_box, *_joint_transform(sibling_joint))))
+    return gap, size, ancestor, joint
+
+
+def _part(name: str, xyz: str, shape: str = '<box size="0.1 0.1 0.1"/>') -> str:
+    return f'<link name="{name}">{LINK_INERTIAL}<collision><origin xyz="{xyz}"/><geometry>{shape}</geometry></collision></link>'
+
+
+def _two_parts(joint_xyz: str, child_xyz: str = "0 0 0.05", axis: str = "0 0 1") -> str:
+    return robot(f"""
+        {_part("base", "0 0 0.05")}
+        {_part("arm", child_xyz)}
+        <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="{joint_xyz}"/>
+          <axis xyz="{axis}"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>""")
+
+
+@rule("G014", "detached-child", "warning", "Link far away from the part it hangs from",
+      why="""A child whose geometry, at the home pose, is further from its parent's geometry (and from
+      its siblings') than the parts are large is almost always a joint origin typed wrong (metres for
+      millimetres, a sign, an exporter's world frame): every parser loads it and the robot flies
+      apart when drawn or simulated (fusion2urdf #42/#50, kuka_experimental #191). Links without
+      geometry in between are looked through (the nearest ancestor with geometry is compared).""",
+      fix="Check the joint's <origin xyz> (units, sign, which frame it is written in) against the drawings.",
+      bad=_two_parts("0 0 3.0"), good=_two_parts("0 0 0.1"),
+      thresholds=f"Reported when the gap between the boxes exceeds both {DETACHED_MIN_GAP} m and {DETACHED_FACTOR:g} "
+                 f"x the larger box diagonal; up to {MAX_WALK} geometry-less links are looked through and "
+                 f"{MAX_SIBLINGS} siblings compared.",
+      references="fusion2urdf issues #42 and #50; ros-industrial/kuka_experimental #191; simcheck 0.2.0 "
+                 "kinematics.attached.")
+def detached_child(ctx) -> Iterator[Hit]:
+    for link in ctx.model.links:
+        found = detachment(ctx, link)
+        if found is None:
+            continue
+        gap, size, ancestor, joint = found
+        if gap > max(DETACHED_MIN_GAP, DETACHED_FACTOR * size):
+            yield Hit(f"link '{link.name}' sits {gap:.3g} m away from link '{ancestor.name}' (parts about "
+                      f"{size:.3g} m across) at the home pose: joint '{joint.name}' origin "
+                      f"xyz=\"{' '.join(f'{v:g}' for v in joint.origin.xyz)}\" looks wrong",
+                      joint.origin.element if joint.origin.element is not None else joint.element)
+
+
+def _overlap_fraction(inner: Box, outer: Box) -> float:
+    """Fraction of ``inner``'s volume inside ``outer`` (flat boxes padded by 1 mm)."""
+    pad = 5e-4
+    a = [(lo - pad, hi + pad) for lo, hi in zip(*inner)]
+    b = [(lo - pad, hi + pad) for lo, hi in zip(*outer)]
+    shared = 1.0
+    volume = 1.0
+    for (alo, ahi), (blo, bhi) in zip(a, b):
+        shared *= max(0.0, min(ahi, bhi) - max(alo, blo))
+        volume *= ahi - alo
+    return shared / volume if volume > 0 else 1.0
+
+
+def collision_offset(link) -> tuple[float, float, Box, Box] | None:
+    """(covered fraction of the visual box, centre offset in m, visual box, collision box), or None."""
+    if not link.visuals or not link.collisions:
+        return None
+    visual = _union(shape_bounds(s) for s in link.visuals)
+    collision = _union(shape_bounds(s) for s in link.collisions)
+    if visual is None or collision is None:
+        return None
+    centre = [(lo + hi) / 2 for lo, hi in zip(*visual)]
+    other = [(lo + hi) / 2 for lo, hi in zip(*collision)]
+    return _overlap_fraction(visual, collision), math.dist(centre, other), visual, collision
+
+
+def _visual_and_collision(collision_xyz: str) -> str:
+    shape = '<geometry><box size="0.1 0.1 0.1"/></geometry>'
+    return robot(f"""
+        <link name="base">{LINK_INERTIAL}<visual>{shape}</visual>
+          <collision><origin xyz="{collision_xyz}"/>{shape}</collision></link>""")
+
+
+@rule("G015", "collision-off-visual", "warning", "Collision geometry does not cover the visual geometry",
+      why="""The collision shapes are what the simulator and the planner see; the visual shapes are
+      what people see. When their boxes barely overlap and their centres are apart (a collision
+      <origin> forgotten, pasted from another link, or a misspelt <orign> ignored), the robot collides
+      where nothing is drawn and passes through what is drawn.""",
+      fix="Give the <collision> the same <origin> as the <visual>, and check its spelling (<orign> is ignored).",
+      bad=_visual_and_collision("0.3 0 0"), good=_visual_and_collision("0 0 0"),
+      thresholds=f"Reported when the collision box covers less than {COVER_MIN:.0%} of the visual box and their "
+                 f"centres are more than {OFFSET_FACTOR:g} visual half-diagonals and {OFFSET_MIN} m apart.",
+      references="simcheck 0.2.0 (collision-vs-visual match).")
+def collision_off_visual(ctx) -> Iterator[Hit]:
+    for link in ctx.model.links:
+        found = collision_offset(link)
+        if found is None:
+            continue
+        covered, offset, visual, _collision = found
+        if covered < COVER_MIN and offset > max(OFFSET_MIN, OFFSET_FACTOR * _diagonal(visual) / 2):
+            yield Hit(f"link '{link.name}' collision box covers {covered:.0%} of its visual box; their centres are "
+                      f"{offset:.3g} m apart", link.collisions[0].element)
+
+
+def _line_box_distance(direction, box: Box) -> float:
+    """Distance from the line through the origin along ``direction`` to ``box`` (convex in the line
+    parameter: a ternary search over the box's extent along the line)."""
+    norm = math.sqrt(sum(v * v for v in direction))
+    if not norm > 0:
+        return 0.0
+    u = [v / norm for v in direction]
+    reach = max(abs(v) for corner in box for v in corner) * 2 + 1.0
+
+    def distance(t: float) -> float:
+        return math.sqrt(sum(max(0.0, lo - t * a, t * a - hi) ** 2 for a, lo, hi in zip(u, *box)))
+
+    low, high = -reach, reach
+    for _ in range(80):
+        m1, m2 = low + (high - low) / 3, high - (high - low) / 3
+        if distance(m1) <= distance(m2):
+            high = m2
+        else:
+            low = m1
+    return distance((low + high) / 2)
+
+
+def axis_offset(ctx, joint) -> tuple[float, float] | None:
+    """(distance from the joint axis to the child's box, the box diagonal) for a hinge, or None."""
+    if joint.type not in ("revolute", "continuous") or joint.child is None:
+        return None
+    child = ctx.model.link(joint.child)
+    box = ctx.link_bounds(child) if child is not None else None
+    if box is None or not all(map(math.isfinite, joint.axis)):
+        return None
+    return _line_box_distance(joint.axis, box), _diagonal(box)
+
+
+@rule("G016", "axis-off-part", "warning", "Hinge axis far from the part it turns",
+      why="""A revolute joint turns its child about a line through the joint origin along <axis>.
+      When that line passes far from the child's geometry, the part swings about thin air: usually
+      a joint origin and a mesh exported in different frames, or an axis typed in the wrong frame.""",
+      fix="Place the joint origin on the hinge (and the child's geometry relative to it), or fix the axis.",
+      bad=_two_parts("0 0 0.1", child_xyz="1.0 0 0.05"), good=_two_parts("0 0 0.1"),
+      thresholds=f"Reported when the distance from the axis line to the child's box exceeds both {AXIS_MIN} m and "
+                 f"{AXIS_FACTOR:g} x the box diagonal.",
+      references="simcheck 0.2.0 (hinge axis off the part).")
+def axis_off_part(ctx) -> Iterator[Hit]:
+    for joint in ctx.model.joints:
+        found = axis_offset(ctx, joint)
+        if found is None:
+            continue
+        distance, size = found
+        if distance > max(AXIS_MIN, AXIS_FACTOR * size):
+            yield Hit(f"joint '{joint.name}' axis passes {distance:.3g} m from link '{joint.child}' "
+                      f"(about {size:.3g} m across)", joint.element)
+
+
+RULES = (detached_child, collision_off_visual, axis_off_part)

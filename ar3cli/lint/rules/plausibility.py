@@ -1,0 +1,185 @@
+"""Plausibility rules (I013-I015): masses no material, part or solver can live with.
+
+Every number is a bound that holds whatever the shapes' overlap: the collision volume of a link is at
+least its largest closed shape and at most the sum of its shapes' boxes, so "too light" is judged on
+primitives alone (exact volumes) and "too dense" on boxes (an upper bound on any mesh's volume).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+
+from ar3cli.lint.rules.base import Hit, arm, robot, rule
+from ar3cli.urdf.bounds import shape_bounds
+
+MIN_DENSITY = 50.0
+"""kg/m³: lighter than rigid foam (expanded polystyrene is 15-30, but no robot part is made of it
+whole); a link this light for its closed collision primitive is a mass in grams, a size in mm, or a
+hollow shell modelled as a solid box."""
+MAX_DENSITY = 25_000.0
+"""kg/m³: denser than osmium (22,590), the densest element: no part can be."""
+MIN_MASS = 1e-3
+"""kg: a moving link lighter than a gram (I003 reports 0 and less)."""
+MAX_MASS_RATIO = 1000.0
+"""Heavier over lighter link across a moving joint."""
+
+
+DENSITY_MIN_MASS = 0.05
+"""kg: lighter links are placeholders (sensor frames at 0.01 kg, contact points at 1e-6 kg), not judged."""
+DENSITY_MIN_SIZE = 0.02
+"""m: shapes whose box diagonal is below this are contact points or markers, not the part's volume."""
+
+
+def rigid_masses(model) -> dict[str, float]:
+    """Link name -> the mass of its rigid group (links welded by fixed joints move as one body: MuJoCo,
+    Drake and Isaac merge them, and the solver sees their sum). Links with a missing or non-finite mass
+    count as 0. Linear: a union-find over the fixed joints."""
+    parent: dict[str, str] = {}
+
+    def find(name: str) -> str:
+        while parent.get(name, name) != name:
+            parent[name] = parent.get(parent[name], parent[name])
+            name = parent[name]
+        return name
+
+    for joint in model.joints:
+        if joint.type == "fixed" and joint.parent and joint.child:
+            a, b = find(joint.parent), find(joint.child)
+            if a != b:
+                parent[b] = a
+    totals: dict[str, float] = {}
+    for link in model.links:
+        mass = link.inertial.mass if link.inertial is not None else None
+        root = find(link.name)
+        totals[root] = totals.get(root, 0.0) + (mass if mass is not None and math.isfinite(mass) and mass > 0 else 0.0)
+    return {link.name: totals[find(link.name)] for link in model.links}
+
+
+def _primitive_volume(shape) -> float | None:
+    """Exact volume of a box, cylinder, sphere or capsule (m³), None for meshes and unknown shapes."""
+    kind, params = shape.geometry.kind, shape.geometry.params
+    try:
+        if kind == "box" and params.get("size"):
+            x, y, z = (abs(float(v)) for v in params["size"])
+            return x * y * z
+        if kind in ("cylinder", "capsule"):
+            r, length = abs(params["radius"]), abs(params["length"])
+            return math.pi * r * r * length + (4 / 3 * math.pi * r ** 3 if kind == "capsule" else 0.0)
+        if kind == "sphere":
+            return 4 / 3 * math.pi * abs(params["radius"]) ** 3
+    except (KeyError, TypeError, ValueError):
+        return None
+    return None
+
+
+def _box_volume(shape) -> float | None:
+    box = shape_bounds(shape)
+    if box is None:
+        return None
+    return math.prod(hi - lo for lo, hi in zip(*box))
+
+
+def density_bounds(link) -> tuple[float | None, float | None]:
+    """(highest possible density, lowest possible density) in kg/m³ from the link's collision shapes;
+    each None when the shapes cannot bound it."""
+    mass = link.inertial.mass if link.inertial is not None else None
+    if mass is None or not mass >= DENSITY_MIN_MASS or not math.isfinite(mass) or not link.collisions:
+        return None, None
+    exact = [_primitive_volume(shape) for shape in link.collisions]
+    largest = max((v for v in exact if v and v ** (1 / 3) * math.sqrt(3) >= DENSITY_MIN_SIZE), default=0.0)
+    highest = mass / largest if largest > 0 else None
+    volumes = []
+    for shapes in (link.collisions, link.visuals):  # the drawn part may be the real one (contact spheres)
+        boxes = [_box_volume(shape) for shape in shapes]
+        if not boxes or not all(v is not None and v > 0 for v in boxes):
+            return highest, None  # a shape of unknown or flat size: no upper bound on the volume
+        volumes.append(sum(boxes))  # type: ignore[arg-type]
+    lowest = mass / max(volumes)
+    return highest, lowest
+
+
+def _dense(mass: str, size: str = "0.1 0.1 0.1") -> str:
+    return robot(f"""
+        <link name="base"><inertial><mass value="{mass}"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
+          <collision><geometry><box size="{size}"/></geometry></collision></link>""")
+
+
+@rule("I013", "density-implausible", "warning", "Link density no material has",
+      why="""Mass over the volume of the link's collision geometry is a density; outside what materials
+      allow, the mass or the geometry is wrong: a mass in grams or a size in millimetres, a hollow cover
+      modelled as a solid box, a copied <mass>. Contact and gravity forces then disagree with the shape
+      the simulator collides with.""",
+      fix="Check the <mass value> (kg) and the collision sizes (m); compute the mass from the real part's density.",
+      bad=_dense("1", "0.5 0.5 0.5"), good=_dense("2.7"),
+      thresholds=f"Reported below {MIN_DENSITY:g} kg/m³ (on the largest collision primitive alone, so overlapping "
+                 f"shapes never make a link look light; meshes are not used, their closed volume is unknown "
+                 f"without reading their triangles) or above {MAX_DENSITY:,.0f} kg/m³ (osmium is 22,590; judged on the "
+                 "sum of the collision (or, when larger, the visual) shapes' boxes, an upper bound on any volume, meshes "
+                 f"included). Links under {DENSITY_MIN_MASS:g} kg and primitives under {DENSITY_MIN_SIZE} m across are "
+                 "placeholders and contact points, not judged.",
+      references="CRC Handbook of Chemistry and Physics (osmium 22.59 g/cm³); simcheck 0.2.0 (density).")
+def density_implausible(ctx) -> Iterator[Hit]:
+    for link in ctx.model.links:
+        highest, lowest = density_bounds(link)
+        where = link.inertial.element.find("mass") if link.inertial is not None else None
+        if highest is not None and highest < MIN_DENSITY:
+            yield Hit(f"link '{link.name}' is at most {highest:.3g} kg/m³ ({link.inertial.mass:g} kg in its collision "
+                      f"shapes): lighter than any solid material", where)
+        elif lowest is not None and lowest > MAX_DENSITY:
+            yield Hit(f"link '{link.name}' is at least {lowest:.4g} kg/m³ ({link.inertial.mass:g} kg in its collision "
+                      f"shapes): denser than any material", where)
+
+
+@rule("I014", "mass-tiny", "warning", "Moving link lighter than a gram",
+      why="""A moving link of less than a gram next to kilogram links makes the joint-space inertia
+      matrix ill-conditioned: PyBullet and MuJoCo then need tiny time steps, and the joint
+      accelerations of that link jitter or blow up. Real moving parts weigh grams at least; a link
+      this light is usually a frame that should hang from a fixed joint, or a mass in the wrong unit.""",
+      fix="Give the link its real mass, or attach a frame-only link with a fixed joint.",
+      bad=arm(link_extra='<inertial><mass value="0.00001"/><inertia ixx="1e-9" ixy="0" ixz="0" iyy="1e-9" iyz="0" izz="1e-9"/></inertial>'),
+      good=arm(),
+      thresholds=f"Moving links (revolute, continuous, prismatic, planar, floating, spherical) whose rigid group (the link "
+                 f"and the links fixed joints weld to it) weighs more than 0 and less than {MIN_MASS:g} kg.",
+      references="MuJoCo documentation, Computation (ill-conditioned mass matrices need smaller timesteps).")
+def mass_tiny(ctx) -> Iterator[Hit]:
+    moving = {joint.child: joint for joint in ctx.model.joints if joint.moves and joint.child}
+    group = rigid_masses(ctx.model)
+    for link in ctx.model.links:
+        mass = link.inertial.mass if link.inertial is not None else None
+        if link.name in moving and mass is not None and mass > 0 and 0 < group[link.name] < MIN_MASS:
+            yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') and weighs {group[link.name]:g} kg "
+                      "with the links welded to it", link.inertial.element.find("mass"))
+
+
+@rule("I015", "mass-ratio", "warning", "Masses across a joint differ more than solvers handle",
+      why="""Iterative solvers converge slowly when the bodies a joint connects differ hugely in mass
+      (PhysX and Unity advise keeping connected masses within 1:10; maximal-coordinate engines drift
+      and jitter). Reduced-coordinate engines (PyBullet's multibody, MuJoCo, Drake) tolerate far more,
+      so only ratios beyond 1000:1 are reported: at that point even they need small time steps, and
+      the light link is usually a frame that should be fixed or a mass in the wrong unit.""",
+      fix="Check both masses (kg); merge a frame-only link into its parent with a fixed joint.",
+      bad=arm(link_extra='<inertial><mass value="0.002"/><inertia ixx="1e-7" ixy="0" ixz="0" iyy="1e-7" iyz="0" izz="1e-7"/></inertial>',
+              base_extra='<inertial><mass value="50"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'),
+      good=arm(base_extra='<inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'),
+      thresholds=f"Heavier / lighter above {MAX_MASS_RATIO:g} across a moving joint, each side's mass being its rigid "
+                 f"group's (links welded by fixed joints); a side lighter than {MIN_MASS:g} kg is I014's alone.",
+      references="Unity Manual, Joint and Ragdoll stability (PhysX: mass ratios below 10); MuJoCo documentation, "
+                 "Computation.")
+def mass_ratio(ctx) -> Iterator[Hit]:
+    model = ctx.model
+    group = rigid_masses(model)
+    for joint in model.joints:
+        if not joint.moves or joint.parent not in group or joint.child not in group:
+            continue
+        masses = [group[joint.parent], group[joint.child]]
+        if not all(m > 0 for m in masses):
+            continue
+        light, heavy = min(masses), max(masses)  # type: ignore[type-var]
+        if light >= MIN_MASS and heavy / light > MAX_MASS_RATIO:
+            yield Hit(f"joint '{joint.name}' connects {masses[0]:g} kg ('{joint.parent}' and what is welded to it) and "
+                      f"{masses[1]:g} kg "
+                      f"('{joint.child}'): ratio {heavy / light:.0f}:1", joint.element)
+
+
+RULES = (density_implausible, mass_tiny, mass_ratio)
