@@ -49,9 +49,10 @@ From a plain install (what a user gets; PYTHONPATH is dropped for the runs)::
     python3 -m venv /tmp/plain && /tmp/plain/bin/pip install .
     python benchmarks/sweep_real_robots.py --ar3cli /tmp/plain/bin/ar3cli
 
-Commands (``--commands``): lint-urdf, lint-urdf-sim, render, sample-collisions, fk-verify,
-fix-inertia, fix-continuous, fix-joints, fix-mesh-paths, fix-collision, info (with --torques),
-install-check.
+Commands (``--commands``): lint-urdf, lint-urdf-sim, lint-urdf-mujoco, cross-check, render,
+sample-collisions, fk-verify, fix-inertia, fix-continuous, fix-joints, fix-mesh-paths, fix-collision,
+diff (each file against itself: any change is silently wrong), report (an HTML page that loads nothing),
+info (with --torques), install-check.
 
 Time on 2 cores with --jobs 2: the static commands (lint-urdf, fix-inertia, fix-continuous) on the
 166 files take under 3 minutes (ar3cli's mesh cache starts empty in every sweep). The simulating
@@ -217,6 +218,10 @@ COMMANDS: tuple[Command, ...] = (
     Command("fix-collision", "fix-collision",
             lambda f, d: ["fix-collision", f, "--diff", "--method", "vhacd", "--resolution", "20000",
                           "--format", "json"]),
+    Command("diff", "diff (a file against itself)",
+            lambda f, d: ["diff", f, f, "--samples", "5", "--seed", "1", "--format", "json"]),
+    Command("report", "report",
+            lambda f, d: ["report", f, "-o", str(d / "report.html"), "--samples", "20", "--seed", "1", "--format", "json"]),
     Command("info", "info --torques",
             lambda f, d: ["info", f, "--torques", "--samples", "20", "--format", "json"]),
     Command("install-check", "install-check", lambda f, d: ["install-check", "--format", "json"],
@@ -475,7 +480,31 @@ def check_fix(document: object, rc: int, run_dir: Path) -> str:
     return f"--diff run reports a write to {written[0]}" if written else ""
 
 
+def check_diff(document: object, rc: int, run_dir: Path) -> str:
+    """A file compared with itself has no semantic change: exit 0 and ``changed`` false."""
+    if not isinstance(document, dict) or "changed" not in document:
+        return "no 'changed' in the JSON"
+    return f"a file differs from itself (exit {rc}, changed={document['changed']})" if rc or document["changed"] else ""
+
+
+def check_report(document: object, rc: int, run_dir: Path) -> str:
+    """An HTML page was written, of the size the JSON says, and it loads nothing from the network."""
+    page = run_dir / "report.html"
+    if not page.is_file():
+        return f"exit {rc} but no page written"
+    data = page.read_bytes()
+    if not data.startswith(b"<!DOCTYPE html>"):
+        return "the page is not HTML"
+    if isinstance(document, dict) and document.get("bytes") != len(data):
+        return f"the JSON says {document.get('bytes')} bytes, the page has {len(data)}"
+    if re.search(rb"""(?:src|href)\s*=\s*["']?https?:""", data):
+        return "the page loads something from the network"
+    return ""
+
+
 CHECKS: dict[str, Callable[[object, int, Path], str]] = {
+    "diff": check_diff,
+    "report": check_report,
     "render": check_render,
     "fk-verify": check_fk,
     "lint-urdf": check_lint,
