@@ -49,9 +49,10 @@ def fix_continuous(
     into revolute joints with the real limits. Edits only those joints, byte for byte, atomically.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix.continuous_plan import ContinuousOptions, make_fixer, read_joint_limits
+    from ar3cli.fix.continuous_plan import ContinuousOptions, make_fixer
     from ar3cli.fix.continuous_plan import verify as verify_in_pybullet
     from ar3cli.fix.driver import run_fixer
+    from ar3cli.urdf.joint_limits_yaml import read_joint_limits
 
     for name, value in (("--effort", effort), ("--velocity", velocity)):
         if value is not None and not value > 0:

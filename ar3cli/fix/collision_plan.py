@@ -32,7 +32,7 @@ from pathlib import Path
 
 from ar3cli.errors import UserError
 from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, verified_in_pybullet
-from ar3cli.fix.edits import Document, Span
+from ar3cli.urdf.edits import Document, Span
 
 MAX_HULL_RATIO = 2.0
 """hull/mesh volume above which a collision mesh is decomposed. A convex mesh is 1; the AR3's

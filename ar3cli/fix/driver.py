@@ -1,7 +1,7 @@
 """The plumbing shared by every fixer: load, plan edits, diff / check / write, report.
 
 A fixer is a function ``(model, document) -> FixPlan`` that queues byte splices on the
-:class:`~ar3cli.fix.edits.Document` and records a :class:`Change` for each field it changes (with
+:class:`~ar3cli.urdf.edits.Document` and records a :class:`Change` for each field it changes (with
 old value, new value and where the new number came from) and a :class:`Skipped` for each element
 it could not fix. :func:`run_fixer` does everything else the same way for all fixers: refuses
 xacro, builds the new bytes, checks they still parse, prints a diff (``--diff``), reports
@@ -19,9 +19,9 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
-from ar3cli.fix.edits import Document
 from ar3cli.infra.atomic import atomic_write, check_writable
 from ar3cli.output.report import OutputFormat, Report, Table, render_report
+from ar3cli.urdf.edits import Document
 
 
 @dataclass

@@ -31,9 +31,9 @@ import numpy as np
 from ar3cli.errors import UserError
 from ar3cli.fix import geometry_mass as inertia
 from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
-from ar3cli.fix.edits import Document
 from ar3cli.lint.rules.inertia import inertia_implausible
 from ar3cli.physics import mass_properties as mp
+from ar3cli.urdf.edits import Document
 from ar3cli.urdf.model import Model
 
 TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")

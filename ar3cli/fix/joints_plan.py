@@ -27,9 +27,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.continuous_plan import YamlLimits
 from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
-from ar3cli.fix.edits import Document
+from ar3cli.urdf.edits import Document
+from ar3cli.urdf.joint_limits_yaml import YamlLimits
 
 INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
 """The lint rules whose findings fix-joints acts on."""

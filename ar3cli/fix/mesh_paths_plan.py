@@ -24,7 +24,7 @@ from pathlib import Path
 
 from ar3cli.errors import UserError
 from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, verified_in_pybullet
-from ar3cli.fix.edits import Document
+from ar3cli.urdf.edits import Document
 
 FILENAME_ELEMENTS = ("mesh", "texture")
 """The URDF elements whose ``filename`` is a URI: ``<mesh>`` in a geometry, ``<texture>`` in a material."""
