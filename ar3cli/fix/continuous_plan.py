@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
+from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
 from ar3cli.urdf.edits import Document
 from ar3cli.urdf.joint_limits_yaml import YamlLimits
 
@@ -35,13 +35,6 @@ class ContinuousOptions:
     effort: float | None = None
     velocity: float | None = None
     warnings: list[str] = field(default_factory=list)
-
-
-def make_fixer(options: ContinuousOptions):
-    def fix(model, document: Document) -> FixPlan:
-        return plan_continuous(model, document, options)
-
-    return fix
 
 
 def plan_continuous(model, document: Document, options: ContinuousOptions) -> FixPlan:
@@ -236,3 +229,8 @@ def _drive(session, body, index: int, target: float, steps: int = 2400) -> float
     for _ in range(steps):
         p.stepSimulation(physicsClientId=session.client)
     return float(p.getJointState(body.id, index, physicsClientId=session.client)[0])
+
+
+FIXER = Fixer[ContinuousOptions]("fix-continuous", plan_continuous, verify)
+"""What ``ar3cli fix-continuous`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
+:func:`plan_continuous`, then :func:`verify` with ``--verify``."""
