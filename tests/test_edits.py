@@ -12,8 +12,8 @@ from pathlib import Path
 
 import pytest
 
-from ar3cli.fix.edits import Document
 from ar3cli.infra.atomic import TEMP_MARKER, atomic_write, stale_temps, temp_files
+from ar3cli.urdf.edits import Document
 from ar3cli.urdf.model import load_model
 from tests.conftest import ASSETS, REPO
 

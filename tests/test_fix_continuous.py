@@ -254,14 +254,13 @@ def test_a_file_pybullet_cannot_load_is_never_called_verified(cli, tmp_path):
 
 def test_a_fix_that_fails_its_pybullet_check_is_not_written(tmp_path, capsys):
     """The verdict line agrees with the table, and a failed check keeps the original file."""
-    from ar3cli.fix.driver import Change, FixPlan, check_row, run_fixer
-    from ar3cli.output.report import OutputFormat
+    from ar3cli.fix.driver import Change, Fixer, FixerArgs, FixPlan, check_row, run_fixer
 
     path = tmp_path / "robot.urdf"
     original = (ASSETS / "examples" / "ar3_fake_continuous.urdf").read_bytes()
     path.write_bytes(original)
 
-    def fixer(model, document):
+    def plan(model, document, options):
         joint = next(j for j in model.joints if j.type == "continuous")
         element = joint.element.find("limit")
         document.remove_attribute(document.span(element), "lower")
@@ -270,8 +269,7 @@ def test_a_fix_that_fails_its_pybullet_check_is_not_written(tmp_path, capsys):
     def verifier(model, plan):
         return {"verified": False, "checks": [check_row("joint j", "limits", False, "made up for the test")]}
 
-    code = run_fixer("fix-continuous", [path], fixer, diff=False, check=False, output=None, fmt=OutputFormat.text,
-                     package_path=None, verifier=verifier)
+    code = run_fixer(Fixer("fix-continuous", plan, verifier), None, FixerArgs([path]), verify=True)
     out = capsys.readouterr().out
     assert code == 1 and path.read_bytes() == original
     assert "verified in PyBullet" not in out and "nothing written: the fixed file failed its check in PyBullet" in out

@@ -12,7 +12,6 @@ from lxml import etree
 
 from ar3cli.collisions import srdf as srdf_files
 from ar3cli.collisions.matrix import PairResult
-from ar3cli.fix.edits import Document
 from ar3cli.urdf.srdf import GENERATED_REASONS, read_srdf
 from tests.conftest import ASSETS, REPO
 
@@ -160,7 +159,7 @@ def merged(text: bytes, tmp_path: Path, sampled=SAMPLED, comment: str = "") -> b
     path = tmp_path / "in.srdf"
     path.write_bytes(text)
     existing = read_srdf(path)
-    return srdf_files.merge(existing, Document(existing.data), sampled, comment).data
+    return srdf_files.merge(existing, sampled, comment).data
 
 
 def test_merge_layouts(tmp_path):

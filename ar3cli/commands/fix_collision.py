@@ -1,28 +1,20 @@
 """``ar3cli fix-collision``: replace non-convex collision meshes by a convex decomposition."""
 
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from ar3cli.commands.options import (
-    CheckOption,
-    DiffOption,
-    FixPathsArgument,
-    FollowSymlinksOption,
-    FormatOption,
-    OutputOption,
-    PackagePathOption,
-    SeedOption,
-    TimeoutOption,
-    finite_float,
-    samples_option,
-)
+from ar3cli.commands.fixer_options import fixer_command, run_fix
+from ar3cli.commands.options import SeedOption, finite_float, samples_option
 from ar3cli.infra.child_limits import LONG_TIMEOUT_S
-from ar3cli.output.report import OutputFormat
+
+if TYPE_CHECKING:
+    from ar3cli.fix.driver import FixerArgs
 
 
+@fixer_command(timeout=LONG_TIMEOUT_S)
 def fix_collision(
-    paths: FixPathsArgument,
+    args: "FixerArgs",
     max_hull_ratio: Annotated[float, typer.Option(
         "--max-hull-ratio", click_type=finite_float(),
         help="Decompose a collision mesh whose convex hull has more than this many times "
@@ -44,13 +36,6 @@ def fix_collision(
     samples: Annotated[int, samples_option("Configurations sampled to compare pair categories before and "
                                            "after the fix.", 100_000)] = 300,
     seed: SeedOption = 0,
-    diff: DiffOption = False,
-    check: CheckOption = False,
-    output: OutputOption = None,
-    follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    format: FormatOption = OutputFormat.text,
-    timeout: TimeoutOption = LONG_TIMEOUT_S,
 ) -> None:
     """Replace a collision mesh that collides as a much larger convex hull by convex parts.
 
@@ -64,22 +49,17 @@ def fix_collision(
     from pathlib import Path
 
     from ar3cli.errors import UserError
-    from ar3cli.fix.collision_plan import CollisionOptions, make_fixer, remove_staging
-    from ar3cli.fix.collision_plan import verify as verify_in_pybullet
+    from ar3cli.fix.collision_plan import FIXER, CollisionOptions, remove_staging
     from ar3cli.fix.decompose import resolve_method
-    from ar3cli.fix.driver import run_fixer
 
     if not max_hull_ratio > 1.0:
         raise UserError(f"--max-hull-ratio {max_hull_ratio}: must be above 1 (a convex mesh is 1)")
     options = CollisionOptions(max_hull_ratio=max_hull_ratio, method=resolve_method(method), resolution=resolution,
-                               from_visual=from_visual, output=output, write=not diff and not check,
-                               follow_symlinks=follow_symlinks, compare=verify, samples=samples, seed=seed,
+                               from_visual=from_visual, output=args.output, write=args.writes,
+                               follow_symlinks=args.follow_symlinks, compare=verify, samples=samples, seed=seed,
                                staging=Path(tempfile.mkdtemp(prefix="ar3cli-parts-")))
     try:
-        code = run_fixer("fix-collision", paths, make_fixer(options), diff=diff, check=check, output=output,
-                         fmt=format, package_path=package_path,
-                         follow_symlinks=follow_symlinks, verifier=verify_in_pybullet if verify else None)
+        run_fix(FIXER, options, args, verify)
     finally:
         options.rollback()  # part files of a URDF that was not rewritten (an error, a failed check)
         remove_staging(options)
-    raise typer.Exit(code)

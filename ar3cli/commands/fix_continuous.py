@@ -1,27 +1,21 @@
 """``ar3cli fix-continuous``: remove fake limits from continuous joints, or give them real ones."""
 
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import (
-    CheckOption,
-    DiffOption,
-    FixPathsArgument,
-    FollowSymlinksOption,
-    FormatOption,
-    OutputOption,
-    PackagePathOption,
-    TimeoutOption,
-    finite_float,
-)
+from ar3cli.commands.fixer_options import fixer_command, run_fix
+from ar3cli.commands.options import finite_float
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
-from ar3cli.output.report import OutputFormat
+
+if TYPE_CHECKING:
+    from ar3cli.fix.driver import FixerArgs
 
 
+@fixer_command(timeout=DEFAULT_TIMEOUT_S)
 def fix_continuous(
-    paths: FixPathsArgument,
+    args: "FixerArgs",
     limits_from: Annotated[Optional[Path], typer.Option(
         "--limits-from", metavar="JOINT_LIMITS_YAML",
         help="MoveIt joint_limits.yaml: joints with has_position_limits become revolute with its limits.")] = None,
@@ -35,13 +29,6 @@ def fix_continuous(
         help="Velocity (rad/s or m/s) to add where a fixed joint's `<limit>` has none.")] = None,
     verify: Annotated[bool, typer.Option(
         "--verify/--no-verify", help="After writing, load the result in PyBullet and check the joints.")] = True,
-    diff: DiffOption = False,
-    check: CheckOption = False,
-    output: OutputOption = None,
-    follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    format: FormatOption = OutputFormat.text,
-    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Fix continuous joints: lower/upper on a continuous joint only add a PyBullet position clamp.
 
@@ -49,16 +36,11 @@ def fix_continuous(
     into revolute joints with the real limits. Edits only those joints, byte for byte, atomically.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix.continuous_plan import ContinuousOptions, make_fixer, read_joint_limits
-    from ar3cli.fix.continuous_plan import verify as verify_in_pybullet
-    from ar3cli.fix.driver import run_fixer
+    from ar3cli.fix.continuous_plan import FIXER, ContinuousOptions
+    from ar3cli.urdf.joint_limits_yaml import read_joint_limits
 
     for name, value in (("--effort", effort), ("--velocity", velocity)):
         if value is not None and not value > 0:
             raise UserError(f"{name} {value}: must be positive")
     limits = read_joint_limits(limits_from) if limits_from is not None else None
-    options = ContinuousOptions(limits, limits_from, to_continuous, effort, velocity)
-    code = run_fixer("fix-continuous", paths, make_fixer(options), diff=diff, check=check, output=output,
-                     fmt=format, package_path=package_path,
-                     follow_symlinks=follow_symlinks, verifier=verify_in_pybullet if verify else None)
-    raise typer.Exit(code)
+    run_fix(FIXER, ContinuousOptions(limits, limits_from, to_continuous, effort, velocity), args, verify)

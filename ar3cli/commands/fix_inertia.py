@@ -1,21 +1,15 @@
 """``ar3cli fix-inertia``: recompute bad ``<inertial>`` elements from the link geometry."""
 
 import math
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import (
-    CheckOption,
-    DiffOption,
-    FixPathsArgument,
-    FollowSymlinksOption,
-    FormatOption,
-    OutputOption,
-    PackagePathOption,
-    finite_float,
-)
-from ar3cli.output.report import OutputFormat
+from ar3cli.commands.fixer_options import fixer_command, run_fix
+from ar3cli.commands.options import finite_float
+
+if TYPE_CHECKING:
+    from ar3cli.fix.driver import FixerArgs
 
 DENSITY_RANGE = (0.01, 1e6)
 """Densities that are a material, in kg/m^3: expanded foams and aerogels start near 1, osmium is
@@ -25,8 +19,9 @@ SMALLEST_MASS = 1e-9
 """A microgram: below it, masses and inertias are round-off, not a robot."""
 
 
+@fixer_command(timeout=None)
 def fix_inertia(
-    paths: FixPathsArgument,
+    args: "FixerArgs",
     links: Annotated[Optional[str], typer.Option("--links", help="Comma-separated links to recompute "
                                                  "(default: the links the linter flags as invalid).")] = None,
     all_links: Annotated[bool, typer.Option("--all", help="Recompute every link that has geometry.")] = False,
@@ -42,12 +37,6 @@ def fix_inertia(
     total_mass: Annotated[Optional[float], typer.Option("--total-mass", metavar="KG", click_type=finite_float(),
                                                         help="The robot's total mass: what the known masses leave "
                                                              "is spread over links without one, by volume.")] = None,
-    diff: DiffOption = False,
-    check: CheckOption = False,
-    output: OutputOption = None,
-    follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    format: FormatOption = OutputFormat.text,
 ) -> None:
     """Recompute mass, centre of mass and inertia tensor of links from their geometry.
 
@@ -58,8 +47,7 @@ def fix_inertia(
     without a valid mass needs --density, --mass or --total-mass: there is no default density.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix.driver import run_fixer
-    from ar3cli.fix.inertia_plan import InertiaOptions, make_fixer, parse_masses
+    from ar3cli.fix.inertia_plan import FIXER, InertiaOptions, parse_masses
 
     if density is not None and not DENSITY_RANGE[0] <= density <= DENSITY_RANGE[1]:
         raise UserError(f"--density {density}: must be a density between {DENSITY_RANGE[0]:g} and "
@@ -72,7 +60,4 @@ def fix_inertia(
         raise UserError("--include-implausible widens the default selection; --links and --all already "
                         "choose the links")
     names = [name.strip() for name in links.split(",") if name.strip()] if links is not None else None
-    options = InertiaOptions(names, all_links, density, parse_masses(mass), total_mass, include_implausible)
-    code = run_fixer("fix-inertia", paths, make_fixer(options), diff=diff, check=check, output=output, fmt=format,
-                     package_path=package_path, follow_symlinks=follow_symlinks)
-    raise typer.Exit(code)
+    run_fix(FIXER, InertiaOptions(names, all_links, density, parse_masses(mass), total_mass, include_implausible), args)

@@ -1,27 +1,21 @@
 """``ar3cli fix-joints``: swap inverted limits, degrees to radians, unit axes, missing effort/velocity."""
 
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import (
-    CheckOption,
-    DiffOption,
-    FixPathsArgument,
-    FollowSymlinksOption,
-    FormatOption,
-    OutputOption,
-    PackagePathOption,
-    TimeoutOption,
-    finite_float,
-)
+from ar3cli.commands.fixer_options import fixer_command, run_fix
+from ar3cli.commands.options import finite_float
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
-from ar3cli.output.report import OutputFormat
+
+if TYPE_CHECKING:
+    from ar3cli.fix.driver import FixerArgs
 
 
+@fixer_command(timeout=DEFAULT_TIMEOUT_S)
 def fix_joints(
-    paths: FixPathsArgument,
+    args: "FixerArgs",
     effort: Annotated[Optional[float], typer.Option(
         "--effort", click_type=finite_float(), help="Effort (N*m or N) to add where a `<limit>` has none (J007).")] = None,
     velocity: Annotated[Optional[float], typer.Option(
@@ -33,13 +27,6 @@ def fix_joints(
              "(before --effort / --velocity).")] = None,
     verify: Annotated[bool, typer.Option(
         "--verify/--no-verify", help="After writing, load the result in PyBullet and read the joints back.")] = True,
-    diff: DiffOption = False,
-    check: CheckOption = False,
-    output: OutputOption = None,
-    follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    format: FormatOption = OutputFormat.text,
-    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
 
@@ -49,17 +36,11 @@ def fix_joints(
     it is reported, with what to do. Only the changed attributes are edited.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix.continuous_plan import read_joint_limits
-    from ar3cli.fix.driver import run_fixer
-    from ar3cli.fix.joints_plan import JointsOptions, make_fixer
-    from ar3cli.fix.joints_plan import verify as verify_in_pybullet
+    from ar3cli.fix.joints_plan import FIXER, JointsOptions
+    from ar3cli.urdf.joint_limits_yaml import read_joint_limits
 
     for name, value in (("--effort", effort), ("--velocity", velocity)):
         if value is not None and not value > 0:
             raise UserError(f"{name} {value}: must be positive")
     limits = read_joint_limits(limits_from) if limits_from is not None else None
-    options = JointsOptions(effort, velocity, limits, limits_from)
-    code = run_fixer("fix-joints", paths, make_fixer(options), diff=diff, check=check, output=output,
-                     fmt=format, package_path=package_path,
-                     follow_symlinks=follow_symlinks, verifier=verify_in_pybullet if verify else None)
-    raise typer.Exit(code)
+    run_fix(FIXER, JointsOptions(effort, velocity, limits, limits_from), args, verify)

@@ -1,4 +1,5 @@
-"""Command-line options shared by several commands, typed once with ``Annotated``."""
+"""Command-line options shared by several commands, typed once with ``Annotated`` (the fixers' own:
+``fixer_options.py``)."""
 
 from __future__ import annotations
 
@@ -96,14 +97,6 @@ def samples_option(help: str, most: int) -> typer.models.OptionInfo:
     return typer.Option("--samples", "-n", min=1, max=most, help=help)
 
 
-# Options shared by the fixers (fix-inertia, fix-continuous).
-FixPathsArgument = Annotated[list[Path], typer.Argument(metavar="PATH", show_default=False,
-                                                        help=".urdf files to fix (xacro is refused).")]
-DiffOption = Annotated[bool, typer.Option("--diff", help="Print a unified diff and write nothing.")]
-CheckOption = Annotated[bool, typer.Option("--check", help="Write nothing; exit 1 when a change is needed.")]
-OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_default=False,
-                                                      help="Write the result to FILE instead of in place "
-                                                           "(one input only).")]
 FollowSymlinksOption = Annotated[bool, typer.Option(
     "--follow-symlinks", help="Write through an output path (or an in-place fix's file) that is a symbolic link, "
                               "replacing the link's target. Without it such a path is refused: a link planted "

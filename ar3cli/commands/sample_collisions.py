@@ -92,7 +92,7 @@ def sample_collisions(
         raise UserError(f"--srdf-merge {srdf_merge}: give --srdf OUT for the merged SRDF (the same path "
                         "updates the file in place)")
     _check_outputs(srdf, pybullet_filter, png, follow_symlinks)
-    existing, document = _read_for_merge(srdf_merge) if srdf_merge is not None else (None, None)
+    existing = srdf_files.read_for_merge(srdf_merge) if srdf_merge is not None else None
     reference = None
     if srdf_compare is not None:
         same = existing is not None and srdf_compare.resolve() == srdf_merge.resolve()
@@ -103,7 +103,7 @@ def sample_collisions(
                f"always threshold {always_threshold}")
     merged = None
     if srdf is not None and existing is not None:
-        merged = srdf_files.merge(existing, document, run.results, comment)
+        merged = srdf_files.merge(existing, run.results, comment)
         merged.target = srdf
         _write(follow_symlinks, srdf, merged.data)
     elif srdf is not None:
@@ -119,21 +119,6 @@ def sample_collisions(
     if reference is not None:
         comparison = srdf_files.compare(reference, run.results, [link.name for link in model.links])
     finish(matrix_report(model, run, format, comparison=comparison, merged=merged), format)
-
-
-def _read_for_merge(path: Path):
-    """The existing SRDF and its byte-span Document, before minutes of sampling (a broken file or
-    one the editor cannot map fails now)."""
-    from ar3cli.fix.edits import Document
-    from ar3cli.urdf.srdf import read_srdf
-
-    existing = read_srdf(path)
-    try:
-        document = Document(existing.data)
-        document.bind(existing.root)
-    except UserError as exc:
-        raise UserError(f"{path}: {exc.message}") from None
-    return existing, document
 
 
 def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | None,

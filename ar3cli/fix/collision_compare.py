@@ -69,7 +69,7 @@ def accept_replacements(model: Any, target: Path, pending: list, inserts: list, 
 
 def candidate_bytes(model: Any, inserts: list, replacements: list) -> bytes:
     """The original bytes with the ``--from-visual`` insertions and ``replacements`` applied."""
-    from ar3cli.fix.edits import Document
+    from ar3cli.urdf.edits import Document
 
     scratch = Document(model.source_bytes)
     scratch.bind(model.root)

@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, verified_in_pybullet
-from ar3cli.fix.edits import Document, Span
+from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, verified_in_pybullet
+from ar3cli.urdf.edits import Document, Span
 
 MAX_HULL_RATIO = 2.0
 """hull/mesh volume above which a collision mesh is decomposed. A convex mesh is 1; the AR3's
@@ -89,13 +89,6 @@ class CollisionOptions:
 def _remove_empty(folder: Path) -> None:
     with contextlib.suppress(OSError):  # not empty: someone else's files are there too
         folder.rmdir()
-
-
-def make_fixer(options: CollisionOptions):
-    def fix(model, document: Document) -> FixPlan:
-        return plan_collisions(model, document, options)
-
-    return fix
 
 
 @dataclass
@@ -539,3 +532,6 @@ def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[s
     return checks
 
 
+FIXER = Fixer[CollisionOptions]("fix-collision", plan_collisions, verify)
+"""What ``ar3cli fix-collision`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
+:func:`plan_collisions`, then :func:`verify` with ``--verify``."""

@@ -18,23 +18,13 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
-from ar3cli.fix.edits import Document
+from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
+from ar3cli.urdf.edits import Document
+from ar3cli.urdf.joint_limits_yaml import YamlLimits
 
 FULL_TURN = 2.0 * math.pi
 FULL_TURN_TOLERANCE = 1e-6
 """rad: files write pi with 8-9 digits (-3.14159265 .. 3.14159265 falls 7e-9 short of a full turn)."""
-
-
-@dataclass(frozen=True)
-class YamlLimits:
-    """One joint of a MoveIt joint_limits.yaml (None where has_* is false or the value absent)."""
-
-    lower: float | None
-    upper: float | None
-    velocity: float | None
-    effort: float | None
 
 
 @dataclass
@@ -45,53 +35,6 @@ class ContinuousOptions:
     effort: float | None = None
     velocity: float | None = None
     warnings: list[str] = field(default_factory=list)
-
-
-def read_joint_limits(path: Path) -> dict[str, YamlLimits]:
-    """Parse MoveIt's ``joint_limits.yaml`` (top key ``joint_limits``); errors are one-line UserErrors."""
-    from ar3cli.urdf.yamlfile import load_yaml
-
-    data = load_yaml(path, "joint limits file")
-    if not isinstance(data, dict) or not isinstance(data.get("joint_limits"), dict):
-        raise UserError(f"{path}: expected MoveIt's format with a top-level 'joint_limits:' mapping")
-    limits: dict[str, YamlLimits] = {}
-    for name, entry in data["joint_limits"].items():
-        if not isinstance(entry, dict):
-            raise UserError(f"{path}: joint_limits.{name} is not a mapping")
-        limits[str(name)] = YamlLimits(
-            _yaml_number(path, name, entry, "min_position", "has_position_limits"),
-            _yaml_number(path, name, entry, "max_position", "has_position_limits"),
-            _yaml_number(path, name, entry, "max_velocity", "has_velocity_limits"),
-            _yaml_number(path, name, entry, "max_effort", "has_effort_limits"))
-        _check_position_limits(path, str(name), entry, limits[str(name)])
-    return limits
-
-
-def _check_position_limits(path: Path, joint: str, entry: dict, limits: YamlLimits) -> None:
-    """A joint that claims position limits must give both, in order (else the fix would be wrong)."""
-    if entry.get("has_position_limits") is not True:
-        return
-    if limits.lower is None or limits.upper is None:
-        raise UserError(f"{path}: joint_limits.{joint} has has_position_limits: true but no min_position/max_position")
-    if limits.lower > limits.upper:
-        raise UserError(f"{path}: joint_limits.{joint}: min_position {limits.lower} is above max_position "
-                        f"{limits.upper}")
-
-
-def _yaml_number(path: Path, joint: str, entry: dict, key: str, flag: str) -> float | None:
-    if entry.get(flag) is not True or key not in entry:
-        return None
-    value = entry[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise UserError(f"{path}: joint_limits.{joint}.{key} is {value!r}, expected a number")
-    return float(value)
-
-
-def make_fixer(options: ContinuousOptions):
-    def fix(model, document: Document) -> FixPlan:
-        return plan_continuous(model, document, options)
-
-    return fix
 
 
 def plan_continuous(model, document: Document, options: ContinuousOptions) -> FixPlan:
@@ -286,3 +229,8 @@ def _drive(session, body, index: int, target: float, steps: int = 2400) -> float
     for _ in range(steps):
         p.stepSimulation(physicsClientId=session.client)
     return float(p.getJointState(body.id, index, physicsClientId=session.client)[0])
+
+
+FIXER = Fixer[ContinuousOptions]("fix-continuous", plan_continuous, verify)
+"""What ``ar3cli fix-continuous`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
+:func:`plan_continuous`, then :func:`verify` with ``--verify``."""

@@ -1,12 +1,14 @@
 """The plumbing shared by every fixer: load, plan edits, diff / check / write, report.
 
-A fixer is a function ``(model, document) -> FixPlan`` that queues byte splices on the
-:class:`~ar3cli.fix.edits.Document` and records a :class:`Change` for each field it changes (with
-old value, new value and where the new number came from) and a :class:`Skipped` for each element
-it could not fix. :func:`run_fixer` does everything else the same way for all fixers: refuses
-xacro, builds the new bytes, checks they still parse, prints a diff (``--diff``), reports
-(``--check``), or writes atomically in place or to ``-o``, optionally verifies the written file
-(in PyBullet for fix-continuous), and renders one table or one JSON document.
+A fixer is a :class:`Fixer`: its command's name, a plan function ``(model, document, options) ->
+FixPlan`` that queues byte splices on the :class:`~ar3cli.urdf.edits.Document` and records a
+:class:`Change` for each field it changes (with old value, new value and where the new number came
+from) and a :class:`Skipped` for each element it could not fix, and optionally a verify function
+that checks the written file in PyBullet. Each ``fix/*_plan.py`` exports one as ``FIXER``.
+:func:`run_fixer` does everything else the same way for all fixers, as the :class:`FixerArgs`
+every fixer command takes ask: refuses xacro, builds the new bytes, checks they still parse,
+prints a diff (``--diff``), reports (``--check``), or writes atomically in place or to ``-o``,
+verifies the written file (``--verify``), and renders one table or one JSON document.
 """
 
 from __future__ import annotations
@@ -16,12 +18,12 @@ import math
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Generic, TypeVar
 
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
-from ar3cli.fix.edits import Document
 from ar3cli.infra.atomic import atomic_write, check_writable
 from ar3cli.output.report import OutputFormat, Report, Table, render_report
+from ar3cli.urdf.edits import Document
 
 
 @dataclass
@@ -57,8 +59,42 @@ class FixPlan:
     """Extra per-file fields for the JSON output (e.g. fix-inertia's ``left_alone``)."""
 
 
-Fixer = Callable[[Any, Document], FixPlan]
+Options = TypeVar("Options")
 Verifier = Callable[[Any, FixPlan], dict[str, Any]]
+"""``verify(model, plan)``: the written file's model and the plan that made it -> the verification
+(``verified_in_pybullet``'s answer: ``verified`` and its ``checks`` rows)."""
+
+
+@dataclass(frozen=True)
+class Fixer(Generic[Options]):
+    """What the driver needs of one fixer; each ``fix/*_plan.py`` exports one as ``FIXER``."""
+
+    name: str
+    """The command (``fix-joints``): the report's title and its JSON ``command``."""
+    plan: Callable[[Any, Document, Options], FixPlan]
+    """``plan(model, document, options)``: queue the splices on ``document``, say what changed and
+    what was skipped; the options are the command's own (``JointsOptions``, ...)."""
+    verify: Verifier | None = None
+    """Checks the written file (in PyBullet); None when there is nothing a load could check."""
+
+
+@dataclass(frozen=True)
+class FixerArgs:
+    """What every fixer command is asked besides its own options: the files and where and how the
+    result goes (``commands/fixer_options.py`` declares the options once)."""
+
+    paths: list[Path]
+    diff: bool = False
+    check: bool = False
+    output: Path | None = None
+    follow_symlinks: bool = False
+    package_path: list[str] | None = None
+    format: OutputFormat = OutputFormat.text
+
+    @property
+    def writes(self) -> bool:
+        """True unless --diff or --check: the fix is written (in place or to -o)."""
+        return not self.diff and not self.check
 
 
 @dataclass
@@ -150,44 +186,45 @@ def refuse_xacro(paths: list[Path]) -> None:
                             ".xacro directly")
 
 
-def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, check: bool, output: Path | None,
-              fmt: OutputFormat, package_path: list[str] | None, verifier: Verifier | None = None,
-              follow_symlinks: bool = False) -> int:
-    """Run ``fixer`` on every path and report; returns the exit code.
+def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: bool = False) -> int:
+    """Run ``fixer`` with its ``options`` on every path of ``args`` and report; returns the exit code.
 
     Every file is loaded and planned before the first write: a bad second input stops the run
     with no file changed, instead of after the first one was rewritten. A symlinked input or
-    ``-o`` is refused unless ``follow_symlinks`` (see :func:`~ar3cli.infra.atomic.check_writable`);
-    an in-place write is refused when the file changed since it was read. With a ``verifier``, a
-    fix whose PyBullet check fails is not written (see :func:`settle_verification`).
+    ``-o`` is refused unless ``--follow-symlinks`` (see :func:`~ar3cli.infra.atomic.check_writable`);
+    an in-place write is refused when the file changed since it was read. With ``verify`` (and a
+    fixer that has a verify step), a fix whose PyBullet check fails is not written (see
+    :func:`settle_verification`).
     """
     from ar3cli.urdf.loading import load_with_specs
 
-    if not paths:
+    output, package_path = args.output, args.package_path
+    verifier = fixer.verify if verify else None
+    if not args.paths:
         raise UserError("give at least one file")
-    if output is not None and len(paths) != 1:
+    if output is not None and len(args.paths) != 1:
         raise UserError("-o/--output takes exactly one input file")
-    refuse_xacro(paths)
+    refuse_xacro(args.paths)
     planned: list[tuple[FixResult, bytes, Any]] = []
-    for path in paths:
+    for path in args.paths:
         model = load_with_specs(path, package_path, None)
         document = Document(model.source_bytes)
         document.bind(model.root)
-        plan = fixer(model, document)
+        plan = fixer.plan(model, document, options)
         new = document.apply()
         result = FixResult(path, plan, changed=new != model.source_bytes)
         if result.changed:
             _check_parses(path, new)
-        if diff and result.changed:
+        if args.diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
         if result.changed:
             result.remaining = remaining_findings(path, new, package_path)
         planned.append((result, new, model))
-    writing = not diff and not check
+    writing = args.writes
     if writing:
         for result, _, _ in planned:
             if result.changed or output is not None:
-                check_writable(output or result.path, follow_symlinks)
+                check_writable(output or result.path, args.follow_symlinks)
     for result, new, original in planned:
         if not writing or not (result.changed or output is not None):
             continue
@@ -201,12 +238,12 @@ def run_fixer(command: str, paths: list[Path], fixer: Fixer, *, diff: bool, chec
                     raise _VerificationFailed
 
         try:
-            atomic_write(target, new, validate, follow_symlinks=follow_symlinks,
+            atomic_write(target, new, validate, follow_symlinks=args.follow_symlinks,
                          expect=original.source_bytes if output is None else None)
         except _VerificationFailed:
             continue
         result.written = target
-    return _report(command, [result for result, _, _ in planned], diff=diff, check=check, fmt=fmt)
+    return _report(fixer.name, [result for result, _, _ in planned], diff=args.diff, check=args.check, fmt=args.format)
 
 
 class _VerificationFailed(Exception):

@@ -30,10 +30,10 @@ import numpy as np
 
 from ar3cli.errors import UserError
 from ar3cli.fix import geometry_mass as inertia
-from ar3cli.fix.driver import Change, FixPlan, Skipped, number, same_numbers
-from ar3cli.fix.edits import Document
+from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, number, same_numbers
 from ar3cli.lint.rules.inertia import inertia_implausible
 from ar3cli.physics import mass_properties as mp
+from ar3cli.urdf.edits import Document
 from ar3cli.urdf.model import Model
 
 TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
@@ -87,15 +87,6 @@ def parse_masses(values: list[str] | None) -> dict[str, float]:
             raise UserError(f"--mass {value!r}: expected LINK=KG with a positive mass, e.g. --mass link_4=0.35")
         masses[name] = mass
     return masses
-
-
-def make_fixer(options: InertiaOptions):
-    """The fixer function for :func:`ar3cli.fix.driver.run_fixer`."""
-
-    def fix(model, document: Document) -> FixPlan:
-        return plan_inertia(model, document, options)
-
-    return fix
 
 
 def _select(model, options: InertiaOptions) -> tuple[dict[str, str], list[LeftAlone]]:
@@ -363,3 +354,8 @@ def _owning_link(element):
     while element is not None and element.tag != "link":
         element = element.getparent()
     return element
+
+
+FIXER = Fixer[InertiaOptions]("fix-inertia", plan_inertia)
+"""What ``ar3cli fix-inertia`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
+:func:`plan_inertia`."""

@@ -27,9 +27,9 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.continuous_plan import YamlLimits
-from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
-from ar3cli.fix.edits import Document
+from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
+from ar3cli.urdf.edits import Document
+from ar3cli.urdf.joint_limits_yaml import YamlLimits
 
 INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
 """The lint rules whose findings fix-joints acts on."""
@@ -45,13 +45,6 @@ class JointsOptions:
     velocity: float | None = None
     limits: dict[str, YamlLimits] | None = None
     limits_path: Path | None = None
-
-
-def make_fixer(options: JointsOptions):
-    def fix(model, document: Document) -> FixPlan:
-        return plan_joints(model, document, options)
-
-    return fix
 
 
 def flagged_joints(model, code: str) -> set[str]:
@@ -231,3 +224,6 @@ def _checks_in_pybullet(model, joints: dict) -> list[dict]:
     return checks
 
 
+FIXER = Fixer[JointsOptions]("fix-joints", plan_joints, verify)
+"""What ``ar3cli fix-joints`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
+:func:`plan_joints`, then :func:`verify` with ``--verify``."""

@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, FixPlan, Skipped, check_row, verified_in_pybullet
-from ar3cli.fix.edits import Document
+from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, verified_in_pybullet
+from ar3cli.urdf.edits import Document
 
 FILENAME_ELEMENTS = ("mesh", "texture")
 """The URDF elements whose ``filename`` is a URI: ``<mesh>`` in a geometry, ``<texture>`` in a material."""
@@ -55,13 +55,6 @@ def parse_packages(items: list[str] | None) -> dict[str, Path]:
     if not packages:
         raise UserError("give at least one --package NAME=DIR (the package the meshes belong to)")
     return packages
-
-
-def make_fixer(options: MeshPathOptions):
-    def fix(model, document: Document) -> FixPlan:
-        return plan_mesh_paths(model, document, options)
-
-    return fix
 
 
 def uri_kind(uri: str) -> str | None:
@@ -213,3 +206,6 @@ def _real(name: bytes) -> str:
     return str(Path(text).resolve()) if text else ""
 
 
+FIXER = Fixer[MeshPathOptions]("fix-mesh-paths", plan_mesh_paths, verify)
+"""What ``ar3cli fix-mesh-paths`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
+:func:`plan_mesh_paths`, then :func:`verify` with ``--verify``."""
