@@ -13,7 +13,7 @@ import pytest
 
 from ar3cli.findings import Severity
 from ar3cli.lint.engine import LintOptions, lint_file
-from ar3cli.lint.rules import REGISTRY, RULES
+from ar3cli.lint.rules import FAMILY_ORDER, REGISTRY, RULES
 from ar3cli.lint.rules.base import LINK_INERTIAL, arm, robot
 
 LFS_POINTER = (b"version https://git-lfs.github.com/spec/v1\n"
@@ -180,7 +180,7 @@ def test_extra_failing_snippets(code, text, files, tmp_path):
 def test_every_rule_has_a_failing_fixture_and_complete_docs():
     for rule in RULES:
         assert rule.bad.strip() and rule.good.strip() and rule.why and rule.fix and rule.title, rule.code
-        assert rule.code[0] in "FSJIGPMT" and len(rule.code) == 4
+        assert rule.code[0] in FAMILY_ORDER and len(rule.code) == 4
         assert isinstance(rule.severity, Severity)
     assert {code for code, _, _ in EXTRA_FAILING} <= set(REGISTRY)
 

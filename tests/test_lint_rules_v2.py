@@ -14,7 +14,7 @@ import pytest
 
 from ar3cli.findings import Severity
 from ar3cli.lint.engine import LintOptions, lint_file
-from ar3cli.lint.rules import REGISTRY, RULES, inertia
+from ar3cli.lint.rules import FAMILY_ORDER, REGISTRY, RULES, inertia
 from ar3cli.lint.rules.base import LINK_INERTIAL, arm, robot
 from ar3cli.urdf import meshinfo
 from tests.conftest import ASSETS
@@ -434,13 +434,13 @@ def test_hull_volume_is_exact_for_a_box_and_zero_for_a_plane():
 # ---- metadata ------------------------------------------------------------------------------------------
 
 def test_fix_inertia_fixes_exactly_the_rules_that_say_so():
-    for rule in inertia.RULES:
+    for rule in inertia.FIXED_BY_FIX_INERTIA:
         assert rule.fixed_by and rule.fixed_by.startswith("fix-inertia"), rule.code
-    for rule in inertia.NOT_FIXED_RULES:
+    for rule in inertia.NOT_FIXED_BY_FIX_INERTIA:
         assert rule.fixed_by is None, rule.code
-    assert inertia.RULES[-1].code == "I007"  # fix-inertia reads I007 as "nothing invalid": it must come last
+    assert inertia.FIXED_BY_FIX_INERTIA[-1].code == "I007"  # fix-inertia reads I007 as "nothing invalid": it must come last
     assert {r.code for r in RULES if r.fixed_by and r.fixed_by.startswith("fix-inertia")} == \
-        {r.code for r in inertia.RULES}
+        {r.code for r in inertia.FIXED_BY_FIX_INERTIA}
 
 
 def test_metadata_reaches_the_docs_and_the_rule_object():
@@ -452,7 +452,7 @@ def test_metadata_reaches_the_docs_and_the_rule_object():
     assert "**References.** MuJoCo include/mujoco/mjtnum.h" in text
     assert REGISTRY["J006"].fixed_by == "fix-continuous"
     codes = [r.code for r in RULES]
-    assert codes == sorted(codes, key=lambda c: ("FSJIGPMT".index(c[0]), c))
+    assert codes == sorted(codes, key=lambda c: (FAMILY_ORDER.index(c[0]), c))
 
 
 # ---- J005 and J003/J014 on virtual base joints and PyBullet's "no limit" idiom (issue 30) ----------

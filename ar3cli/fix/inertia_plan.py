@@ -326,19 +326,19 @@ def _tensor_text(values: dict[str, str | None]) -> str:
 
 def links_needing_inertia(model: Model) -> dict[str, str]:
     """``{link name: "CODE name: message"}`` for every link the lint inertia rules that fix-inertia
-    fixes (``RULES`` of lint/rules/inertia.py: I001-I009) flag.
+    fixes (``FIXED_BY_FIX_INERTIA`` of lint/rules/inertia.py: I001-I009) flag.
 
     The linter is the one definition of "bad inertia": fix-inertia fixes exactly what it reports,
     so a fixed link lints clean. Inline ``<!-- ar3cli: ignore[CODE] -->`` suppressions are honoured.
     """
     from ar3cli.lint.context import Context
     from ar3cli.lint.engine import suppressed_inline
-    from ar3cli.lint.rules.inertia import RULES
+    from ar3cli.lint.rules.inertia import FIXED_BY_FIX_INERTIA
 
     context = Context(model)
     found: dict[str, str] = {}
     try:
-        for rule in RULES:
+        for rule in FIXED_BY_FIX_INERTIA:
             for hit in rule.check(context):
                 element = _owning_link(hit.element)
                 if element is None or suppressed_inline(hit.element, rule.code):

@@ -52,14 +52,13 @@ def flagged_joints(model, code: str) -> set[str]:
     ``code`` reports on ``model``, by running the rule's own check, imported at call time: the rule
     is the one definition of what it flags."""
     from ar3cli.lint.context import Context
-    from ar3cli.lint.rules import joints as joint_rules
-    from ar3cli.lint.rules.base import Rule
+    from ar3cli.lint.rules import REGISTRY
 
-    rules = [value for value in vars(joint_rules).values() if isinstance(value, Rule) and value.code == code]
-    if not rules or rules[0].check is None:
-        raise UserError(f"internal: lint rule {code} not found in ar3cli.lint.rules.joints")
+    found = REGISTRY.get(code)
+    if found is None or found.check is None:
+        raise UserError(f"internal: lint rule {code} is not in the rule registry")
     names: set[str] = set()
-    for hit in rules[0].check(Context(model)):
+    for hit in found.check(Context(model)):
         element = hit.element
         while element is not None and element.tag != "joint":
             element = element.getparent()

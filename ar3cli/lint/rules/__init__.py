@@ -2,40 +2,32 @@
 
 Codes are grouped by family prefix (F file, S structure, J joints, I inertia, G geometry,
 P simulation in PyBullet, M MuJoCo, T target engines) and never reused. To add a rule: write one decorated function in its family module
-and add it to that module's ``RULES`` tuple; docs/rules.md is generated from this registry
+(the decorator registers it; every module of this package is imported, so a new family module
+needs no list either); docs/rules.md is generated from this registry
 (``python -m ar3cli.lint.rules.docs > docs/rules.md``) and a test keeps the two equal.
 """
 
 from __future__ import annotations
 
-from ar3cli.lint.rules import (
-    consistency,
-    file,
-    geometry,
-    inertia,
-    joints,
-    mujoco,
-    plausibility,
-    schema,
-    sim,
-    structure,
-    targets,
-)
-from ar3cli.lint.rules.base import FAMILIES, Hit, Rule
+import importlib
+import pkgutil
 
-FAMILY_ORDER = "FSJIGPMT"
-"""Families in registry (and docs) order."""
+from ar3cli.lint.rules.base import FAMILIES, FAMILY_ORDER, Hit, Rule, registered
 
-RULES: tuple[Rule, ...] = tuple(sorted(
-    (*file.RULES, *structure.RULES, *joints.RULES, *inertia.RULES, *inertia.NOT_FIXED_RULES, *geometry.RULES,
-     *sim.RULES, *mujoco.RULES, *schema.RULES, *consistency.RULES, *plausibility.RULES, *targets.RULES),
-    key=lambda r: (FAMILY_ORDER.index(r.code[0]), r.code)))
-"""Every rule in family order, then by code (a family module may list its rules in another order:
-``inertia.RULES`` is fix-inertia's order of reasons)."""
+NOT_RULE_MODULES = frozenset({"base", "docs"})
+"""Modules of this package that define no rules (the building blocks, the docs generator)."""
+RULE_MODULES: tuple[str, ...] = tuple(sorted(
+    info.name for info in pkgutil.iter_modules(__path__) if info.name not in NOT_RULE_MODULES))
+"""Every module of this package that holds rules, found on disk: a new family module needs no list."""
+for _module in RULE_MODULES:
+    importlib.import_module(f"{__name__}.{_module}")
+
+RULES: tuple[Rule, ...] = registered()
+"""Every rule in family order (:data:`FAMILY_ORDER`), then by code: each one registered itself when its
+module defined it (the :func:`~ar3cli.lint.rules.base.rule` decorator)."""
 REGISTRY: dict[str, Rule] = {r.code: r for r in RULES}
-assert len(REGISTRY) == len(RULES), "duplicate rule code"
 
-__all__ = ["FAMILIES", "REGISTRY", "RULES", "Hit", "Rule", "matches", "validate_patterns"]
+__all__ = ["FAMILIES", "FAMILY_ORDER", "REGISTRY", "RULES", "Hit", "Rule", "matches", "validate_patterns"]
 
 
 def matches(code: str, patterns) -> bool:

@@ -29,7 +29,10 @@ FAMILIES = {
     "M": "mujoco",
     "T": "targets",
 }
-"""Code prefix -> family name; the prefix is the first letter of every code."""
+"""Code prefix -> family name; the prefix is the first letter of every code. Its order is the family
+order of the registry, docs/rules.md and every listing (:data:`FAMILY_ORDER`)."""
+FAMILY_ORDER = "".join(FAMILIES)
+"""The family prefixes in registry order: ``"FSJIGPMT"``."""
 
 
 @dataclass(frozen=True)
@@ -91,20 +94,43 @@ class Rule:
         return f"{self.code.lower()}-{self.name}"
 
 
+_REGISTERED: dict[str, Rule] = {}
+"""Every rule made by :func:`rule`, by code: defining a rule registers it (see :func:`registered`)."""
+
+
+def _register(made: Rule) -> Rule:
+    """Add ``made`` to the registry; a second rule with the same code is a programming error."""
+    if made.code[:1] not in FAMILIES or len(made.code) != 4:
+        raise ValueError(f"rule code {made.code!r} must be a family prefix ({FAMILY_ORDER}) and three digits")
+    known = _REGISTERED.get(made.code)
+    if known is not None and known.name != made.name:
+        raise ValueError(f"duplicate rule code {made.code}: {known.name} and {made.name}")
+    _REGISTERED[made.code] = made
+    return made
+
+
+def registered() -> tuple[Rule, ...]:
+    """Every rule defined so far, in family order then by code. ``ar3cli.lint.rules`` imports every
+    module of its package first, so from there this is every rule there is."""
+    return tuple(sorted(_REGISTERED.values(), key=lambda r: (FAMILY_ORDER.index(r.code[0]), r.code)))
+
+
 def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str, bad: str, good: str,
          needs_sim: bool = False, fixed_by: str | None = None, thresholds: str | None = None,
          references: str | None = None, opt_in: bool = False,
          targets: tuple[str, ...] = ()) -> Callable[[Check | None], Rule]:
-    """Decorator turning a check function into a :class:`Rule` (the function's name is unused)."""
+    """Decorator turning a check function into a :class:`Rule` and registering it: a rule written
+    anywhere in the ``ar3cli.lint.rules`` package is in the engine, the docs and the tests (the
+    function's name is unused)."""
 
     def wrap(check: Check | None) -> Rule:
-        return Rule(code=code, name=name, severity=Severity(severity), title=title,
+        return _register(Rule(code=code, name=name, severity=Severity(severity), title=title,
                     why=" ".join(why.split()), fix=" ".join(fix.split()),
                     bad=textwrap.dedent(bad).strip() + "\n", good=textwrap.dedent(good).strip() + "\n",
                     check=check, needs_sim=needs_sim, fixed_by=fixed_by,
                     thresholds=" ".join(thresholds.split()) if thresholds else None,
                     references=" ".join(references.split()) if references else None, opt_in=opt_in,
-                    targets=targets)
+                    targets=targets))
 
     return wrap
 

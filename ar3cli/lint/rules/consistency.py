@@ -267,6 +267,3 @@ def axis_off_part(ctx) -> Iterator[Hit]:
         if distance > max(AXIS_MIN, AXIS_FACTOR * size):
             yield Hit(f"joint '{joint.name}' axis passes {distance:.3g} m from link '{joint.child}' "
                       f"(about {size:.3g} m across)", joint.element)
-
-
-RULES = (detached_child, collision_off_visual, axis_off_part)

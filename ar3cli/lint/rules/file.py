@@ -149,6 +149,3 @@ def malformed_number(ctx) -> Iterator[Hit]:
             problem = number_problem(text, count)
             if problem:
                 yield Hit(f"<{element.tag} {key}=\"{text}\"> {problem}", element)
-
-
-RULES = (unreadable, not_xml, not_robot, xacro_failed, strict_parser, unexpanded_substitution, malformed_number)

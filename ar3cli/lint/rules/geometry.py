@@ -383,7 +383,3 @@ def hull_much_larger(ctx) -> Iterator[Hit]:
         if ratio > HULL_RATIO:
             yield Hit(f"link '{link.name}' collision mesh {shape.geometry.filename}: its convex hull is at least "
                       f"{ratio:.1f}x its volume, and engines collide the hull", shape.geometry.element)
-
-
-RULES = (mesh_not_found, empty_package, absolute_path, mesh_format, lfs_pointer, mesh_units, scalar_scale,
-         no_collision, pybullet_only_path, non_spec_geometry, mesh_unreadable, mesh_flat, hull_much_larger)

@@ -379,9 +379,9 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
                        "the real <inertial>); a fixed-base arm can ignore this.")
 
 
-RULES = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,
+FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,
          inertia_triangle, inertia_zero, inertia_zero_fixed_link, inertia_near_singular, inertia_implausible)
 """The rules whose links fix-inertia recomputes (:func:`ar3cli.fix.inertia_plan.links_needing_inertia`),
 in its order of reasons: I007 last, so a link reported as I007 has nothing invalid."""
-NOT_FIXED_RULES = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
+NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
 """Inertia findings fix-inertia leaves alone: the fix is a decision only the author can make."""

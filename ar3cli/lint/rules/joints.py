@@ -451,8 +451,3 @@ def pybullet_unlimited_idiom(ctx) -> Iterator[Hit]:
             yield Hit(f"{joint.type} joint '{joint.name}' lower {limit.lower:g} > upper {limit.upper:g}: PyBullet's "
                       "\"no limit\" idiom (unlimited in PyBullet; urdfdom and MoveIt read an inverted range)",
                       limit.element)
-
-
-RULES = (limit_missing, limit_range_missing, limit_inverted, limit_empty, limit_degrees, continuous_with_range,
-         effort_velocity_missing, effort_velocity_zero, axis_zero, axis_not_unit, continuous_arm_joint,
-         mimic_not_single_dof, joint_type_portability, pybullet_unlimited_idiom)

@@ -154,6 +154,3 @@ def mujoco_unstable(ctx) -> Iterator[Hit]:
     if bad_acceleration and not reported:
         yield Hit(f"MuJoCo reported {bad_acceleration} unstable step(s) (bad acceleration; the simulation was reset)",
                   ctx.model.root)
-
-
-RULES = (mujoco_compile_failed, mujoco_mesh_unreadable, mujoco_self_collision_home, mujoco_unstable)

@@ -180,6 +180,3 @@ def mass_ratio(ctx) -> Iterator[Hit]:
             yield Hit(f"joint '{joint.name}' connects {masses[0]:g} kg ('{joint.parent}' and what is welded to it) and "
                       f"{masses[1]:g} kg "
                       f"('{joint.child}'): ratio {heavy / light:.0f}:1", joint.element)
-
-
-RULES = (density_implausible, mass_tiny, mass_ratio)

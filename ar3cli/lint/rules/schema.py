@@ -285,6 +285,3 @@ def undeclared_urdf_version(ctx) -> Iterator[Hit]:
                 yield Hit(f"{_owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
                           "(urdfdom ignores it)", element,
                           hint=f'Declare <robot name="..." version="{major}.{minor}"> (or later).')
-
-
-RULES = (unknown_element, unknown_attribute, attribute_as_element, missing_required_child, undeclared_urdf_version)

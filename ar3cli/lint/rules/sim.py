@@ -184,6 +184,3 @@ def sim_unstable(ctx) -> Iterator[Hit]:
             elif abs(velocity) > MAX_SETTLE_SPEED:
                 yield Hit(f"joint '{joint.name}' moves at {velocity:.3g} after {SETTLE_STEPS} steps under gravity",
                           joint.urdf.element if joint.urdf else None)
-
-
-RULES = (sim_load_failed, sim_self_collision_home, sim_inertia_differs, sim_unstable)

@@ -406,8 +406,3 @@ def link_order(ctx) -> Iterator[Hit]:
         more = f" ({len(early) - 1} more link{'s' if len(early) > 2 else ''} too)" if len(early) > 1 else ""
         yield Hit(f"link '{link.name}' is declared before its parent '{parent}'{more}: pybullet with "
                   "URDF_MAINTAIN_LINK_ORDER gives it and the links below it NaN frames", link.element)
-
-
-RULES = (robot_name, duplicate_link, duplicate_joint, missing_link, several_roots, not_a_tree,
-         unknown_joint_reference, undefined_material, joint_type, pybullet_joint_type, no_links,
-         transmission_fixed_joint, duplicate_actuator, duplicate_element, link_order)

@@ -225,7 +225,3 @@ def drake_ignores(ctx) -> Iterator[Hit]:
         if "SimpleTransmission" not in kind:
             yield Hit(f"transmission '{transmission.get('name', '?')}' type '{kind.strip()}': Drake reads only "
                       "SimpleTransmission and ignores it", transmission)
-
-
-RULES = (pybullet_mimic_ignored, mujoco_mimic, mujoco_same_mesh_name, mujoco_collada, isaac_empty_root, isaac_prim_name,
-         isaac_joint_order, drake_ignores)
