@@ -8,7 +8,7 @@ Writes, below ``OUTPUT_DIR`` (default: the folder of this script):
 * ``examples/*.urdf``       copies of ``ar3.urdf`` with one classic mistake each.
 
 Why a generator: the geometry is primitives (boxes and cylinders) and every ``<inertial>``
-is computed from that geometry with :mod:`ar3cli.physics.mass_properties`, so editing a shape by
+is computed from that geometry with :mod:`ar3cli.maths.mass_properties`, so editing a shape by
 hand would leave a stale inertia behind. Run the script after any change; the tests
 check that the committed files equal its output byte for byte.
 
@@ -38,7 +38,7 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:  # allow `python assets/make_ar3.py` from a plain checkout
     sys.path.insert(0, str(REPO))
 
-from ar3cli.physics import mass_properties as mp  # noqa: E402 - after the sys.path line that finds ar3cli
+from ar3cli.maths import mass_properties as mp  # noqa: E402 - after the sys.path line that finds ar3cli
 
 PI = math.pi
 
@@ -71,7 +71,7 @@ def parse_vec(text: str) -> np.ndarray:
 
 
 def matrix_to_rpy(rot: np.ndarray) -> np.ndarray:
-    """Inverse of :func:`ar3cli.physics.mass_properties.rpy_to_matrix` (URDF fixed-axis x-y-z)."""
+    """Inverse of :func:`ar3cli.maths.mass_properties.rpy_to_matrix` (URDF fixed-axis x-y-z)."""
     pitch = math.atan2(-rot[2, 0], math.hypot(rot[0, 0], rot[1, 0]))
     if math.isclose(abs(pitch), PI / 2, abs_tol=1e-9):  # gimbal lock: put it all in yaw
         return np.array([0.0, pitch, math.atan2(-rot[0, 1], rot[1, 1])])

@@ -21,11 +21,11 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("application", ["cli"]),
     ("commands", ["commands"]),
     ("fixers", ["fix"]),
-    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "doctor", "info", "robot_diff", "scan",
+    ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "install_check", "info", "robot_diff", "scan",
                   "cross_check"]),
     ("simulation", ["sim"]),
     ("robot files", ["urdf"]),
-    ("maths", ["physics"]),
+    ("maths", ["maths"]),
     ("services", ["output", "infra"]),
     ("vocabulary", ["errors", "findings", "__init__"]),
 ]

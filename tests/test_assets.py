@@ -21,7 +21,7 @@ import pybullet as p
 import pytest
 from lxml import etree
 
-from ar3cli.physics import mass_properties as mp
+from ar3cli.maths import mass_properties as mp
 from ar3cli.sim.capture import capture_fds
 from tests.conftest import ASSETS, REPO, SHARED
 

@@ -11,7 +11,7 @@ import pytest
 
 from ar3cli.fix.geometry_mass import capsule
 from ar3cli.fix.inertia_plan import links_needing_inertia
-from ar3cli.physics import mass_properties as mp
+from ar3cli.maths import mass_properties as mp
 from ar3cli.urdf.model import load_model
 from tests.conftest import ASSETS
 from tests.fixer_helpers import element_lines, lint_findings, only_within, remove_inertial, replace_in_link, write

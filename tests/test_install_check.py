@@ -9,7 +9,7 @@ import sys
 
 import pytest
 
-from ar3cli.doctor import checks as doctor
+from ar3cli.install_check import checks as doctor
 from tests.conftest import REPO
 
 
@@ -49,7 +49,7 @@ def test_determinism_check_detects_identical_states():
 
 
 def test_a_line_per_capability(cli):
-    from ar3cli.doctor.capabilities import CAPABILITIES
+    from ar3cli.install_check.capabilities import CAPABILITIES
 
     data = json.loads(cli("install-check", "--format", "json").stdout)
     rows = {check["name"]: check for check in data["checks"]}
@@ -66,7 +66,7 @@ BLOCKED = """
 import json, sys
 for module in sys.argv[1].split(","):
     sys.modules[module] = None  # as if the distribution were not installed
-from ar3cli.doctor.capabilities import CAPABILITIES, capability_check
+from ar3cli.install_check.capabilities import CAPABILITIES, capability_check
 capability = next(c for c in CAPABILITIES if c.name == sys.argv[2])
 print(json.dumps(capability_check(capability)().to_dict()))
 """

@@ -1,4 +1,4 @@
-"""Tests for ar3cli.physics.mass_properties: textbook values, combination and validity checks."""
+"""Tests for ar3cli.maths.mass_properties: textbook values, combination and validity checks."""
 
 from __future__ import annotations
 
@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from ar3cli.physics import mass_properties as mp
+from ar3cli.maths import mass_properties as mp
 
 EXACT = 1e-9
 

@@ -82,7 +82,7 @@ def test_the_scan_sees_imports_inside_functions():
 
 def test_every_capability_needs_only_declared_libraries():
     """trimesh declares none of its optional libraries: what a capability needs must be listed by ar3cli."""
-    from ar3cli.doctor.capabilities import CAPABILITIES
+    from ar3cli.install_check.capabilities import CAPABILITIES
 
     dependencies = declared()
     extras = {name: {_name(r) for r in requirements}

@@ -165,7 +165,7 @@ def test_run_isolated_names_the_signal_and_the_stage(tmp_path, monkeypatch) -> N
 
 @needs_fork
 def test_install_check_reports_a_crashing_check_and_goes_on() -> None:
-    from ar3cli.doctor.checks import Check, run_checks
+    from ar3cli.install_check.checks import Check, run_checks
 
     def check_boom() -> Check:
         os.kill(os.getpid(), signal.SIGSEGV)

@@ -8,8 +8,8 @@ from fractions import Fraction
 import numpy as np
 import pytest
 
-from ar3cli.physics import mass_properties as mp
-from ar3cli.physics import tensor_math as tm
+from ar3cli.maths import mass_properties as mp
+from ar3cli.maths import tensor_math as tm
 
 
 def _random_tensors(count: int, seed: int = 7):

@@ -17,8 +17,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from ar3cli.physics import mass_properties as mp
-from ar3cli.physics import tensor_math as tm
+from ar3cli.maths import mass_properties as mp
+from ar3cli.maths import tensor_math as tm
 from ar3cli.urdf.model import load_model
 
 DATA = Path(__file__).parent / "data" / "urdf12"

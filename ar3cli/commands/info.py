@@ -56,8 +56,8 @@ def info(
     zero configuration (every joint at 0) with the URDF's own forward kinematics. --torques adds
     the gravity torque check (PyBullet), --png a picture of the kinematic tree.
     """
+    from ar3cli.info.presentation import report
     from ar3cli.info.summary import summarize
-    from ar3cli.info.text import report
     from ar3cli.kinematics.fk import urdf_link_frames
 
     if png is not None:

@@ -1,4 +1,4 @@
-"""``ar3cli install-check``: the environment doctor."""
+"""``ar3cli install-check``: what this environment can run (the probes live in ``install_check/``)."""
 
 
 from ar3cli.commands.options import FormatOption
@@ -11,7 +11,7 @@ def install_check(format: FormatOption = OutputFormat.text) -> None:
     Each check prints ok / warn / fail / info, a detail, and for problems the exact command to run.
     Exit code 1 when any check fails.
     """
-    from ar3cli.doctor.checks import run_checks
+    from ar3cli.install_check.checks import run_checks
 
     checks = run_checks()
     ok = not any(check.status == "fail" for check in checks)

@@ -50,7 +50,7 @@ def render_command(
     No display or GPU is needed.
     """
     from ar3cli.infra.atomic import check_writable
-    from ar3cli.pictures.render import draw_robot, parse_configuration
+    from ar3cli.pictures.draw import draw_robot, parse_configuration
 
     output = check_writable(output, follow_symlinks)  # before any work; a planted link is refused
     configuration = parse_configuration(config)

@@ -130,8 +130,8 @@ def lint_document(path: Path, package_path: list[str] | None, xacro_arg: list[st
 
 def _info(model, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict, list[str], list[str]]:
     """``info --torques --samples N --seed S --format json``'s document, its summary and torque lines."""
+    from ar3cli.info.presentation import report, summary_lines, torque_lines
     from ar3cli.info.summary import summarize
-    from ar3cli.info.text import report, summary_lines, torque_lines
     from ar3cli.info.torques import gravity_torques
     from ar3cli.kinematics.fk import urdf_link_frames
 
@@ -145,7 +145,7 @@ def _pictures(model, notes: list[str]) -> list[dict[str, Any]]:
     """Three sides, visual then collision geometry (render's own drawing: contacts at home in red)."""
     import tempfile
 
-    from ar3cli.pictures.render import draw_robot
+    from ar3cli.pictures.draw import draw_robot
 
     pictures = []
     with tempfile.TemporaryDirectory(prefix="ar3cli-report-") as folder:

@@ -1,6 +1,6 @@
 """Mass properties of a link from its geometry.
 
-Primitives use :mod:`ar3cli.physics.mass_properties` (exact, analytic). Meshes use trimesh: scale
+Primitives use :mod:`ar3cli.maths.mass_properties` (exact, analytic). Meshes use trimesh: scale
 and COLLADA ``<unit meter>`` applied (as PyBullet does; trimesh reads the unit but leaves it out),
 exact signed-tetrahedra volume when the mesh is watertight, otherwise its convex hull with the
 hull/mesh volume ratio reported. Each shape's ``<origin>`` is applied and the shapes of
@@ -19,7 +19,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ar3cli.physics import mass_properties as mp
+from ar3cli.maths import mass_properties as mp
 from ar3cli.urdf.bounds import mesh_unit
 from ar3cli.urdf.model import Link, Model, Shape
 
@@ -87,7 +87,7 @@ def _positive(value: float | None) -> bool:
 
 
 def capsule(radius: float, length: float) -> mp.MassProperties:
-    """Unit-density capsule along z (:func:`ar3cli.physics.mass_properties.capsule`, closed form)."""
+    """Unit-density capsule along z (:func:`ar3cli.maths.mass_properties.capsule`, closed form)."""
     return mp.capsule(radius, length, density=1.0)
 
 

@@ -32,7 +32,7 @@ from ar3cli.errors import UserError
 from ar3cli.fix import geometry_mass as inertia
 from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, number, same_numbers
 from ar3cli.lint.rules.inertia import inertia_implausible
-from ar3cli.physics import mass_properties as mp
+from ar3cli.maths import mass_properties as mp
 from ar3cli.urdf.edits import Document
 from ar3cli.urdf.model import Model
 

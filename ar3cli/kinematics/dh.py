@@ -38,7 +38,6 @@ CONVENTIONS = ("standard", "modified")
 ROW_KEYS = {"joint", "a", "alpha", "d", "theta_offset", "sign"}
 TOP_KEYS = {"convention", "base", "tip", "units", "base_offset", "tool", "joints"}
 ANGLE_FIELDS = ("alpha", "theta_offset")
-LENGTH_FIELDS = ("a", "d")
 
 
 @dataclass(frozen=True)

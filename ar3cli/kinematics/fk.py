@@ -24,8 +24,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ar3cli.errors import UserError
-from ar3cli.physics.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
-from ar3cli.physics.tensor_math import matrix_to_rpy
+from ar3cli.maths.mass_properties import rpy_to_matrix as rpy_matrix  # Rz(yaw) Ry(pitch) Rx(roll)
+from ar3cli.maths.tensor_math import matrix_to_rpy
 from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, ROTATING_JOINT_TYPES, Joint, Model
 

@@ -3,7 +3,7 @@ and for the robot the total mass and the centre of mass at the home pose.
 
 The inertia is compared in the link frame (``R I R^T`` with the ``<inertial>`` origin's rotation),
 so a tensor written about rotated axes but equal in the link frame is no change. A change is
-explained by its principal moments (:func:`~ar3cli.physics.tensor_math.symmetric_eigenvalues`) and
+explained by its principal moments (:func:`~ar3cli.maths.tensor_math.symmetric_eigenvalues`) and
 by how far the principal axes turned (only between distinct moments: equal moments have no axes).
 """
 
@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from ar3cli.physics.tensor_math import rpy_to_matrix, symmetric_eigenvalues
+from ar3cli.maths.tensor_math import rpy_to_matrix, symmetric_eigenvalues
 from ar3cli.robot_diff.pair import Pair
 from ar3cli.robot_diff.records import Change, finite_or_none, show
 from ar3cli.robot_diff.tolerance import distance

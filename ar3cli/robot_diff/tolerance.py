@@ -11,7 +11,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ar3cli.physics.tensor_math import rpy_to_matrix
+from ar3cli.maths.tensor_math import rpy_to_matrix
 
 DEFAULT = 1e-9
 """Default for all three tolerances: far below any manufacturing tolerance, far above the rounding

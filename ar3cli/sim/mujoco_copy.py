@@ -136,7 +136,7 @@ def _link_file(path: Path, folder: Path, index: int) -> str:
 def _replace_with_box(shape: Any, mesh: Any, collision: Any) -> str:
     """Turn the copied ``<mesh>`` into the mesh's box (its origin moved to the box centre), or drop the
     copied collision when the size is unknown; what was done, in words."""
-    from ar3cli.physics.tensor_math import rpy_to_matrix
+    from ar3cli.maths.tensor_math import rpy_to_matrix
     from ar3cli.urdf.bounds import metric_mesh_bounds
 
     box = metric_mesh_bounds(shape.geometry)

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from ar3cli.physics.tensor_math import rpy_to_matrix
+from ar3cli.maths.tensor_math import rpy_to_matrix
 
 Vector = tuple[float, float, float]
 Box = tuple[Vector, Vector]

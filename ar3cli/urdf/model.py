@@ -19,7 +19,7 @@ from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import read_bytes
-from ar3cli.physics.tensor_math import matrix_to_rpy, quaternion_to_matrix, rpy_to_matrix, unit_quaternion
+from ar3cli.maths.tensor_math import matrix_to_rpy, quaternion_to_matrix, rpy_to_matrix, unit_quaternion
 from ar3cli.urdf import xacro_expand, xmlsource
 from ar3cli.urdf.packages import PackageResolver, Resolution
 from ar3cli.urdf.xmlsource import Quirk

@@ -7,7 +7,7 @@ from collections.abc import Iterator
 from functools import lru_cache
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
-from ar3cli.physics.tensor_math import is_positive_definite, satisfies_triangle_inequality, symmetric_eigenvalues
+from ar3cli.maths.tensor_math import is_positive_definite, satisfies_triangle_inequality, symmetric_eigenvalues
 
 IMPLAUSIBLE_FACTOR = 3.0
 """Radius of gyration above this many half-diagonals of the geometry's box cannot be real (see I007)."""

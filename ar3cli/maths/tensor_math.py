@@ -2,7 +2,7 @@
 
 Importing numpy costs ~0.1-0.2 s, more than linting a typical robot; the static rules only
 need eigenvalues of 3x3 inertia tensors and URDF rotations, which closed forms give in
-microseconds. :mod:`ar3cli.physics.mass_properties` delegates to these functions (so there is one
+microseconds. :mod:`ar3cli.maths.mass_properties` delegates to these functions (so there is one
 definition of "positive definite" and of the triangle inequality) and wraps the results in
 numpy arrays for its own array math.
 

@@ -22,7 +22,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
-from ar3cli.doctor.record import Check
+from ar3cli.install_check.record import Check
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ import time
 from collections.abc import Callable
 from pathlib import Path
 
-from ar3cli.doctor.record import Check
+from ar3cli.install_check.record import Check
 from ar3cli.sim.capture import capture_fds
 
 MIN_PYTHON = (3, 10)
@@ -196,13 +196,13 @@ CHECKS: list[Callable[[], Check]] = [
 
 def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
     """Run ``checks`` (default: :data:`CHECKS`, then one per capability of
-    :mod:`ar3cli.doctor.capabilities`), each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside one
-    becomes a ``fail`` for that check only, and so does a crash of pybullet's C code (a broken
+    :mod:`ar3cli.install_check.capabilities`), each in a forked child (:mod:`ar3cli.infra.isolation`): an exception inside
+    one becomes a ``fail`` for that check only, and so does a crash of pybullet's C code (a broken
     build), which would otherwise end install-check with no report at all."""
     from ar3cli.infra.isolation import CrashError, run_isolated
 
     if checks is None:
-        from ar3cli.doctor.capabilities import CAPABILITY_CHECKS
+        from ar3cli.install_check.capabilities import CAPABILITY_CHECKS
 
         checks = [*CHECKS, *CAPABILITY_CHECKS]
     results = []

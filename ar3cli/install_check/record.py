@@ -1,7 +1,7 @@
 """One install-check row: what was checked, how it went, and what to run when it did not go well.
 
-Its own module so that both the environment checks (:mod:`ar3cli.doctor.checks`) and the capability
-checks (:mod:`ar3cli.doctor.capabilities`) build rows without importing each other.
+Its own module so that both the environment checks (:mod:`ar3cli.install_check.checks`) and the capability
+checks (:mod:`ar3cli.install_check.capabilities`) build rows without importing each other.
 """
 
 from __future__ import annotations

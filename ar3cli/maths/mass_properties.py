@@ -15,7 +15,7 @@ Conventions (the same as URDF ``<inertial>``):
   z, i.e. ``R = Rz(yaw) @ Ry(pitch) @ Rx(roll)``.
 
 The functions use numpy but not pybullet or trimesh. The 3x3 eigenvalue and rotation
-formulas live in :mod:`ar3cli.physics.tensor_math` (plain Python, so that the linter need not import
+formulas live in :mod:`ar3cli.maths.tensor_math` (plain Python, so that the linter need not import
 numpy); the functions here delegate to them and return numpy arrays. Mesh-based mass
 properties belong in a separate function that returns the same ``MassProperties`` type.
 """
@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ar3cli.physics import tensor_math
+from ar3cli.maths import tensor_math
 
 __all__ = [
     "MassProperties",
@@ -225,5 +225,5 @@ def is_positive_definite(inertia: ArrayLike) -> bool:
 
 def satisfies_triangle_inequality(inertia: ArrayLike, tol: float = 1e-12) -> bool:
     """True when each principal moment is at most the sum of the other two (+ ``tol``); see
-    :func:`ar3cli.physics.tensor_math.satisfies_triangle_inequality`."""
+    :func:`ar3cli.maths.tensor_math.satisfies_triangle_inequality`."""
     return tensor_math.satisfies_triangle_inequality(_matrix(inertia), tol)

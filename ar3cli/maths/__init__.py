@@ -1,0 +1,1 @@
+"""Tensor maths and mass properties of primitives: pure numbers, no robot files, no engines."""
