@@ -67,7 +67,7 @@ class FiniteFloat(_float_range_type()):
     click's FLOAT and FloatRange take them: ``nan`` even passes ``min``/``max``, because every
     comparison with NaN is false, and then reaches the maths and the JSON (``--always-threshold nan``
     was exit 3 with ``--format json``). Every float option of every command uses this type through
-    :func:`finite_float`; ``tests/test_output_v3.py`` walks the app to check that none is missed.
+    :func:`finite_float`; ``tests/test_output_edge_cases.py`` walks the app to check that none is missed.
     """
 
     name = "float"

@@ -1,4 +1,4 @@
-"""Lint v3 (issue 24): schema, geometric consistency, plausibility and target-engine rules.
+"""Lint v3 (issue 24), each injected defect class: schema, geometric consistency, plausibility and target-engine rules.
 
 Each defect class of the issue, injected by hand into a small robot (tests/data/lint_v3/), is found
 at the line of the element that holds it; a file full of extensions stays quiet; ``--target`` adds
