@@ -285,6 +285,8 @@ def test_options_and_io_errors(cli, tmp_path, write_urdf):
         (["--density", "-3"], "must be a density between"),
         (["--density", "inf"], "must be a finite number"),
         (["--total-mass", "inf"], "must be a finite number"),
+        (["--mass", "box=1e-320"], "at least 1e-09 kg"),
+        (["--total-mass", "1e-320"], "at least 1e-09 kg"),
     ]:
         result = cli("fix-inertia", str(path), *args)
         assert result.code == 2 and message in result.stderr and "Traceback" not in result.stderr

@@ -15,8 +15,6 @@ DENSITY_RANGE = (0.01, 1e6)
 """Densities that are a material, in kg/m^3: expanded foams and aerogels start near 1, osmium is
 22,590; the margins take units slips the user meant. Outside it the inertia written is no
 physics (``--density 1e-320`` gave masses of 1e-323 kg, subnormal numbers that underflow to 0)."""
-SMALLEST_MASS = 1e-9
-"""A microgram: below it, masses and inertias are round-off, not a robot."""
 
 
 @fixer_command(timeout=None)
@@ -47,7 +45,7 @@ def fix_inertia(
     without a valid mass needs --density, --mass or --total-mass: there is no default density.
     """
     from ar3cli.errors import UserError
-    from ar3cli.fix.inertia_plan import FIXER, InertiaOptions, parse_masses
+    from ar3cli.fix.inertia_plan import FIXER, SMALLEST_MASS, InertiaOptions, parse_masses
 
     if density is not None and not DENSITY_RANGE[0] <= density <= DENSITY_RANGE[1]:
         raise UserError(f"--density {density}: must be a density between {DENSITY_RANGE[0]:g} and "

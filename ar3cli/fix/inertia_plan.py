@@ -74,8 +74,13 @@ class _Target:
     """Why no mass source applies (shown instead of the generic "give --density ..." when set)."""
 
 
+SMALLEST_MASS = 1e-9
+"""A microgram: below it, masses and inertias are round-off, not a robot (``--mass`` and ``--total-mass``;
+``--mass arm=1e-320`` wrote inertias of 1e-323, subnormal numbers)."""
+
+
 def parse_masses(values: list[str] | None) -> dict[str, float]:
-    """``LINK=KG`` pairs; malformed ones raise UserError."""
+    """``LINK=KG`` pairs; malformed ones, and masses below :data:`SMALLEST_MASS`, raise UserError."""
     masses: dict[str, float] = {}
     for value in values or []:
         name, sep, kg = value.partition("=")
@@ -85,6 +90,8 @@ def parse_masses(values: list[str] | None) -> dict[str, float]:
             mass = float("nan")
         if not sep or not name or not (math.isfinite(mass) and mass > 0):
             raise UserError(f"--mass {value!r}: expected LINK=KG with a positive mass, e.g. --mass link_4=0.35")
+        if mass < SMALLEST_MASS:
+            raise UserError(f"--mass {value!r}: must be a mass of at least {SMALLEST_MASS:g} kg")
         masses[name] = mass
     return masses
 
