@@ -57,7 +57,8 @@ _PORTABILITY_QUIRKS = ("version-", "leading-junk", "trailing-junk", "undeclared-
 def strict_parser(ctx) -> Iterator[Hit]:
     for quirk in ctx.model.quirks:
         if quirk.code.startswith(_PORTABILITY_QUIRKS):
-            hint = ('Declare the prefix on <robot>, e.g. xmlns:drake="http://drake.mit.edu" for Drake\'s elements.'
+            hint = ('Declare each prefix on <robot> as xmlns:PREFIX="URI", whether it names elements or attributes '
+                    '(Drake\'s drake: prefix is xmlns:drake="http://drake.mit.edu").'
                     if quirk.code == "undeclared-prefix" else None)
             yield Hit(quirk.message, line=quirk.line, hint=hint)
 
