@@ -71,7 +71,9 @@ def test_an_unloadable_visual_is_replaced_with_a_warning_and_the_picture_made(cl
     out = tmp_path / "r.png"
     result = cli("render", str(path), "-o", str(out), "--width", "64", "--height", "48", "--format", "json")
     assert result.code == 0, result.stderr
-    assert out.exists() and json.loads(result.stdout)
+    assert out.exists()
+    not_drawn = json.loads(result.stdout)["visuals_not_drawn"]  # the JSON says what the picture leaves out
+    assert len(not_drawn) == 2 and not_drawn[0].startswith("link 'base'") and "left out" in not_drawn[1]
     warnings = [line for line in result.stderr.splitlines() if "render: warning" in line]
     assert len(warnings) == 2
     assert "link 'base'" in warnings[0] and "'.glb'" in warnings[0] and "collision shape instead" in warnings[0]

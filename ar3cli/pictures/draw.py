@@ -29,18 +29,22 @@ COLLISION_RGBA = "0.15 0.55 0.95 1"
 
 @dataclass
 class RenderResult:
-    """What was drawn: the file, the image size, the joint values used and the links in contact."""
+    """What was drawn: the file, the image size, the joint values used, the links in contact and the
+    visuals that could not be drawn (one warning each: a picture that leaves parts out says so, in
+    JSON too)."""
 
     path: Path
     width: int
     height: int
     configuration: dict[str, float]
     contacts: list[tuple[str, str, float]] = field(default_factory=list)
+    not_drawn: list[str] = field(default_factory=list)
 
     def to_dict(self) -> dict:
         return {"path": str(self.path), "width": self.width, "height": self.height,
                 "configuration": self.configuration,
-                "contacts": [{"link_a": a, "link_b": b, "depth_m": d} for a, b, d in self.contacts]}
+                "contacts": [{"link_a": a, "link_b": b, "depth_m": d} for a, b, d in self.contacts],
+                "visuals_not_drawn": self.not_drawn}
 
 
 def parse_configuration(text: str | None) -> dict[str, float]:
@@ -151,7 +155,7 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
         raise UserError(f"image size {width}x{height} is out of range (16..4096 pixels per side)")
     if not output.parent.is_dir():
         raise UserError(f"-o {output}: folder {output.parent} does not exist")
-    shown = model
+    shown, warnings = model, []
     if not show_collision:
         shown, warnings = drawable_visuals(model)
         for warning in warnings if warn is not None else ():
@@ -168,7 +172,8 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
     buffer = io.BytesIO()
     Image.fromarray(rgb).save(buffer, format="PNG")
     atomic_write(output, buffer.getvalue())
-    return RenderResult(output, width, height, values, contacts)
+    return RenderResult(output, width, height, values, contacts,
+                        [warning.removeprefix("render: warning: ") for warning in warnings])
 
 
 def _draw(model: Model, configuration: Mapping[str, float], width: int, height: int, yaw_deg: float,
