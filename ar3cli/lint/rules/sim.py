@@ -184,3 +184,47 @@ def sim_unstable(ctx) -> Iterator[Hit]:
             elif abs(velocity) > MAX_SETTLE_SPEED:
                 yield Hit(f"joint '{joint.name}' moves at {velocity:.3g} after {SETTLE_STEPS} steps under gravity",
                           joint.urdf.element if joint.urdf else None)
+
+
+def _swinging_arm(limit: float) -> str:
+    """P005's example: an arm standing on a plate, turning about x within +-``limit`` rad (past ~1.3 it dips into the plate)."""
+    return robot(f"""
+          <link name="base">{LINK_INERTIAL}<collision><origin xyz="0 0 -0.05"/><geometry><box size="0.3 0.3 0.1"/></geometry></collision></link>
+          <link name="arm">{LINK_INERTIAL}<collision><origin xyz="0 0 0.12"/><geometry><box size="0.05 0.05 0.2"/></geometry></collision></link>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.02"/>
+            <axis xyz="1 0 0"/><limit lower="-{limit}" upper="{limit}" effort="10" velocity="1"/></joint>""")
+
+
+@rule("P005", "sim-passes-through-parent", "warning", "A part passes through its parent when its joint moves",
+      why="""PyBullet never tests a link against its direct parent for self-collision and MoveIt calls
+      the pair adjacent, so a child that swings through its parent's body is seen by no other check,
+      and the robot's planners happily command poses the real robot cannot reach. ar3cli sweeps each
+      movable joint over its range (SWEEP_STEPS = 13 values, limits included; continuous joints over a
+      full turn; the other joints at home, mimic joints following) and measures how deep the child's
+      collision geometry sinks into its parent's (the nearest ancestor with collision geometry). Real
+      parent and child meshes overlap at the joint at every angle, by design: only the depth *added*
+      relative to the home pose counts. Children without collision geometry and prismatic joints without
+      limits are skipped; at most
+      MAX_SWEPT_JOINTS = 64 joints are swept, so a huge robot stays fast.""",
+      fix="Fix the joint limits (the child should stop where it meets its parent) or the collision geometry "
+          "(a convex hull of a concave part fills its hollow: split it or use a simpler shape).",
+      bad=_swinging_arm(limit=3.1), good=_swinging_arm(limit=1.2), needs_sim=True,
+      thresholds="Reported when the penetration depth at some step exceeds the depth at home by more than "
+                 "max(MIN_NEW_DEPTH = 0.01 m, SIZE_FRACTION = 0.6 x the smaller part's size (the middle extent of "
+                 "its bounding box)); SWEEP_STEPS = 13 per joint, MAX_SWEPT_JOINTS = 64.")
+def sim_passes_through_parent(ctx) -> Iterator[Hit]:
+    from ar3cli.sim.pass_through import pass_throughs
+
+    with _loaded(ctx, self_collision="all-pairs") as body:  # else getClosestPoints skips a link and its parent
+        if body is None or body.nonfinite_links():
+            return
+        try:
+            found_all = list(pass_throughs(body))
+        except UserError:
+            return  # limits that cannot be sampled: F007 reports them
+        for found in found_all:
+            unit = "m" if found.joint.urdf_type == "prismatic" else "rad"
+            yield Hit(f"moving joint '{found.joint.name}' to {found.value:.3g} {unit} sinks link '{found.child}' "
+                      f"{_depth_text(found.depth)} into its parent '{found.parent}' (at home: "
+                      f"{_depth_text(found.home_depth)}; threshold: {_depth_text(found.threshold)} more)",
+                      found.joint.urdf.element if found.joint.urdf else None)
