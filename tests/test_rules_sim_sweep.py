@@ -56,3 +56,16 @@ def test_sweep_values_include_the_limits_or_cover_a_full_turn(lower, upper, cont
         assert min(values) > -3.1416 and max(values) < 3.1416 and min(abs(values)) < 1e-12
     else:
         assert values[0] == lower and values[-1] == upper
+
+
+def test_an_infinite_limit_leaves_the_other_rules_running(tmp_path):
+    """``lower="-inf"`` ended a whole ``lint-urdf --sim`` of the file with exit 2 (the home pose of P002
+    and P004 could not be sampled); F007 reports it at its line and the other findings stay."""
+    text = (DATA / "quiet.urdf").read_text()
+    start = text.index('lower="', text.index("<limit"))
+    end = text.index('"', start + len('lower="'))
+    path = tmp_path / "inf.urdf"
+    path.write_text(text[:start] + 'lower="-inf' + text[end:])
+    options = LintOptions(sim=True)
+    rules = {f.rule for f in lint_file(path, options.rules(), options).findings}
+    assert "F007" in rules

@@ -36,10 +36,15 @@ def _loaded(ctx, **load_options):
         body.remove()
 
 
-def _home(body) -> dict[str, float]:
+def _home(body) -> dict[str, float] | None:
+    """The body's home pose, or None when a joint's limits are not finite numbers: F007 reports those
+    at their line, and the other rules of the file still run (a lint must not end at one bad limit)."""
     from ar3cli.sim.sampling import home_positions
 
-    return home_positions(body)
+    try:
+        return home_positions(body)
+    except UserError:
+        return None
 
 
 @rule("P001", "sim-load-failed", "error", "PyBullet cannot load the model",
@@ -87,9 +92,10 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.urdf.srdf import is_disabled
 
     with _loaded(ctx, self_collision="all-pairs") as body:
-        if body is None:
+        home = _home(body) if body is not None else None
+        if home is None:
             return
-        body.set_positions(_home(body))
+        body.set_positions(home)
         group = rigid_groups(ctx.model, (joint.name for joint in body.actuated_joints))
         for a, b, depth in nonadjacent_collisions(body):
             if is_disabled(ctx.srdf_disabled, a, b):
@@ -172,9 +178,10 @@ def _differs(used: float, declared: float) -> bool:
       thresholds='A joint NaN/inf, or faster than MAX_SETTLE_SPEED = 100 rad/s or m/s, after SETTLE_STEPS = 240 steps (1 s) under gravity.')
 def sim_unstable(ctx) -> Iterator[Hit]:
     with _loaded(ctx) as body:
-        if body is None or not body.actuated_joints:
+        home = _home(body) if body is not None and body.actuated_joints else None
+        if home is None:
             return
-        body.set_positions(_home(body))
+        body.set_positions(home)
         body.release_motors()
         ctx.session.step(SETTLE_STEPS)  # the lint session has gravity (lint.Context.session)
         for joint, (position, velocity) in zip(body.actuated_joints, body.joint_states()):
