@@ -25,7 +25,7 @@ FAMILIES = {
     "J": "joints",
     "I": "inertia",
     "G": "geometry",
-    "P": "sim",
+    "P": "pybullet",
     "M": "mujoco",
     "T": "targets",
 }

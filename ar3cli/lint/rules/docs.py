@@ -16,6 +16,10 @@ child of the element (or of any ancestor). P rules run only with `--sim`.
 """
 
 
+FAMILY_TITLES = {"pybullet": "PyBullet", "mujoco": "MuJoCo", "targets": "Target engines"}
+"""Headings for the families whose name does not capitalise into their title."""
+
+
 def generate() -> str:
     """The whole Markdown document."""
     out = [HEADER, "| code | name | severity | title |", "| --- | --- | --- | --- |"]
@@ -26,7 +30,7 @@ def generate() -> str:
         if rule.family != family:
             family = rule.family
             prefix = next(p for p, name in FAMILIES.items() if name == family)
-            out += ["", f"## {family.capitalize()} ({prefix})"]
+            out += ["", f"## {FAMILY_TITLES.get(family, family.capitalize())} ({prefix})"]
         out += [
             "", f"### {rule.code} {rule.name}", "",
             f"**{rule.title}.** Severity: {rule.severity.value}." + (" Runs only with `--sim`." if rule.needs_sim else "")
