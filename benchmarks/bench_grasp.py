@@ -147,7 +147,11 @@ def main() -> None:
         plain_whole = [sim / run.wall for sim, run in zip(sims, plain.runs)]
         plain_loop = [sim / loop for sim, loop in zip(sims, plain_loops)]
         successes = sum(bool(document["success"]) for document in demo_docs)
+        floor = [run.wall / mine.wall for run, mine in zip(plain.runs, demo.runs)]
         comparison.notes += [
+            f"**ratio: grasp-demo's real-time factor / the bare-world floor's (plain script), whole processes, "
+            f"round by round: median {statistics.median(floor):.2f}** (issue 29's target: >= 0.8; per round: "
+            + " ".join(f"{value:.2f}" for value in floor) + ")",
             f"simulated time per run: median {statistics.median(sims):.3f} s (from the JSON's sim_time_s; "
             f"{statistics.median(d['steps'] for d in demo_docs):.0f} steps of {TIMESTEP * 1000:.4f} ms), "
             f"{successes}/{len(demo_docs)} grasps succeeded",

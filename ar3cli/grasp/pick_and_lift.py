@@ -165,7 +165,7 @@ class IKSolver:
 
     def __init__(self, session: Any, model: Any, tcp_link: str = TCP_LINK, iterations: int = 8) -> None:
         self.session = session
-        self.body = session.load(model, fixed_base=True)
+        self.body = session.load(model, fixed_base=True, visuals=False)  # IK never draws: loads faster
         self.p, self.client = session.p, session.client
         self.tcp = self.body.link_index[tcp_link]
         movable = self.body.actuated_joints
@@ -244,7 +244,10 @@ class GraspScene:
             arm_model = load_model(asset("ar3/ar3.urdf"))
             cube_model = load_model(asset("objects/cube.urdf"))
             self.ground = make_ground(p, client)
-            self.arm = self.session.load(arm_model, fixed_base=True)
+            # the visual meshes only matter to a picture (--gui, --record's frame hook): without one
+            # the arm loads without them, which changes no contact, mass or frame
+            drawn = gui or frame_hook is not None
+            self.arm = self.session.load(arm_model, fixed_base=True, visuals=drawn)
             self.cube_half = cube_model.links[0].collisions[0].geometry.params["size"][2] / 2
             xy, self.cube_yaw = sample_cube_pose(seed, settings)
             self.cube_start = np.array([xy[0], xy[1], self.cube_half])
@@ -252,7 +255,7 @@ class GraspScene:
             # phases' contact steps are ~30% cheaper (measured 116 vs 168 us per step)
             self.cube = self.session.load(cube_model, fixed_base=False, base_position=self.cube_start,
                                           base_orientation=p.getQuaternionFromEuler([0, 0, self.cube_yaw]),
-                                          maximal_coordinates=True)
+                                          maximal_coordinates=True, visuals=drawn)
             self.arm_model = arm_model
             # Friction anchors on the pads and the cube: without them pybullet's contact
             # friction lets a squeezed box creep and tilt (measured: 5-18 deg and up to 1 cm of
@@ -268,6 +271,9 @@ class GraspScene:
         self.arm_joints = [joints[name] for name in ARM_JOINTS]
         self.finger_joints = [joints[name] for name in FINGER_JOINTS]
         self.arm_indices = [joint.index for joint in self.arm_joints]
+        self.finger_indices = [joint.index for joint in self.finger_joints]
+        self.arm_position_gains = [0.3] * len(self.arm_joints)
+        self.arm_velocity_gains = [1.0] * len(self.arm_joints)
         self.arm_forces = [joint.effort for joint in self.arm_joints]
         self.arm_velocity = np.array([joint.velocity for joint in self.arm_joints])
         self.tcp = self.arm.link_index[TCP_LINK]
@@ -344,22 +350,26 @@ class GraspScene:
         force stays ``2 * gripper_force`` and moves towards the finger that is behind, each
         finger's force within [0, effort]: a proportional coupling, not a constraint.
         """
-        p, client = self.p, self.client
-        states = p.getJointStates(self.arm.id, [joint.index for joint in self.finger_joints], physicsClientId=client)
+        p, client, arm = self.p, self.client, self.arm.id
+        states = p.getJointStates(arm, self.finger_indices, physicsClientId=client)
         share = (states[0][0] - states[1][0]) / self.settings.centring_span
-        force = self.settings.gripper_force
+        force, target, control = self.settings.gripper_force, self.finger_target, p.POSITION_CONTROL
         for joint, sign in zip(self.finger_joints, (-1.0, 1.0)):
             bounded = min(joint.effort, max(0.0, force * (1.0 + sign * share)))
-            p.setJointMotorControl2(self.arm.id, joint.index, p.POSITION_CONTROL, targetPosition=self.finger_target,
-                                    force=bounded, maxVelocity=joint.velocity, positionGain=0.3, velocityGain=1.0,
+            p.setJointMotorControl2(arm, joint.index, control, targetPosition=target, force=bounded,
+                                    maxVelocity=joint.velocity, positionGain=0.3, velocityGain=1.0,
                                     physicsClientId=client)
 
     def command_arm(self, q: Sequence[float], qdot: Sequence[float]) -> None:
         self.target_q = np.asarray(q, dtype=float)
+        self._send_arm(self.target_q.tolist(), np.asarray(qdot, dtype=float).tolist())
+
+    def _send_arm(self, q: list[float], qdot: list[float]) -> None:
+        """The arm's position-control command (plain float lists: the per-step call of a move)."""
         self.p.setJointMotorControlArray(self.arm.id, self.arm_indices, self.p.POSITION_CONTROL,
-                                         targetPositions=list(q), targetVelocities=list(qdot),
-                                         forces=self.arm_forces, positionGains=[0.3] * len(q),
-                                         velocityGains=[1.0] * len(q), physicsClientId=self.client)
+                                         targetPositions=q, targetVelocities=qdot, forces=self.arm_forces,
+                                         positionGains=self.arm_position_gains,
+                                         velocityGains=self.arm_velocity_gains, physicsClientId=self.client)
 
     def step(self) -> None:
         if self.squeezing:
@@ -378,9 +388,12 @@ class GraspScene:
         start = self.target_q
         for goal, duration in zip(waypoints, durations):
             count = max(1, round(duration / TIMESTEP))
-            velocity = (goal - start) / (count * TIMESTEP)
-            for i in range(1, count + 1):
-                self.command_arm(start + (goal - start) * (i / count), velocity)
+            velocity = ((goal - start) / (count * TIMESTEP)).tolist()
+            # every step's target at once: start + (goal - start) * (i / count), the same floats
+            # as one numpy expression per step, without its per-step cost
+            fractions = np.arange(1, count + 1) / count
+            for target in (start + (goal - start) * fractions[:, None]).tolist():
+                self._send_arm(target, velocity)
                 self.step()
             start = goal
         self.command_arm(start, np.zeros_like(start))

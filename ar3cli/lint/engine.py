@@ -115,8 +115,9 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
 
 
 FILES_PER_WORKER = 24
-"""Automatic --jobs adds a process per this many files (a static lint takes ~1.5 ms a file; a
-forked process ~3 ms to start and hand its findings back)."""
+"""Automatic --jobs adds a process per this many files (a forked process costs ~3 ms to start and
+hand its findings back; a static lint of a file ~5 ms with lint v3's rules, ~100 ms when its meshes
+are read for the first time). The number is also in lint-urdf's --help and docs/commands/lint-urdf.md."""
 SIM_FILES_PER_WORKER = 2
 """With --sim a file takes a few hundred milliseconds: two files repay a process."""
 
@@ -139,10 +140,36 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
         return [lint_file(path, rules, options, cache) for path in files]
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
-    outcomes = map_in_processes(job, files, workers, what="a lint worker")
-    for _, learned in outcomes:
+    order = balanced_order([_size(path) for path in files], workers)
+    outcomes = map_in_processes(job, [files[index] for index in order], workers, what="a lint worker")
+    results: list[LintResult] = [None] * len(files)  # type: ignore[list-item]
+    for index, (result, learned) in zip(order, outcomes):
         merge_learned(learned)
-    return [result for result, _ in outcomes]
+        results[index] = result
+    return results
+
+
+def balanced_order(sizes: list[int], workers: int) -> list[int]:
+    """Indices of the items in the order that gives round-robin dealing to ``workers`` processes
+    (:func:`~ar3cli.infra.process_pool.map_in_processes`: worker ``w`` takes positions ``w``,
+    ``w + workers``, ...) shares of about equal size: largest first, each round of ``workers``
+    dealt in the opposite direction of the one before (a snake draft). A robot's file size
+    follows its link and mesh count; dealt in command-line order, one process got the big robots
+    and the other waited."""
+    by_size = sorted(range(len(sizes)), key=lambda index: -sizes[index])
+    order: list[int] = []
+    for start in range(0, len(by_size), workers):
+        chunk = by_size[start:start + workers]
+        order += chunk if (start // workers) % 2 == 0 else chunk[::-1]
+    return order
+
+
+def _size(path: Path) -> int:
+    """The file's size in bytes (0 when it cannot be read: its one-line finding is cheap)."""
+    try:
+        return os.stat(path).st_size
+    except (OSError, ValueError):
+        return 0
 
 
 def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions,
