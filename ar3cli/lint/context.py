@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from typing import Any, TypeVar
 
-from ar3cli.urdf.bounds import Box, link_bounds
-from ar3cli.urdf.model import Link, Model
+from ar3cli.urdf.bounds import Box, link_bounds, shape_bounds
+from ar3cli.urdf.model import Link, Model, Shape
+
+T = TypeVar("T")
 
 
 class Context:
@@ -17,13 +20,30 @@ class Context:
         self.srdf_disabled = srdf_disabled
         """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf.is_disabled`)."""
         self._bounds: dict[str, Box | None] = {}
+        self._shape_bounds: dict[int, Box | None] = {}
         self._session: Any = None
+        self._shared: dict[str, Any] = {}
+
+    def shared(self, key: str, build: Callable[[Model], T]) -> T:
+        """``build(model)``, computed once per file for every rule that asks with the same ``key``
+        (the schema rules' walk of the URDF elements: five rules, one walk)."""
+        if key not in self._shared:
+            self._shared[key] = build(self.model)
+        return self._shared[key]
 
     def link_bounds(self, link: Link) -> Box | None:
         """Box around the link's collision (else visual) shapes in its frame, or None."""
         if link.name not in self._bounds:
-            self._bounds[link.name] = link_bounds(link)
+            self._bounds[link.name] = link_bounds(link, self.shape_bounds)
         return self._bounds[link.name]
+
+    def shape_bounds(self, shape: Shape) -> Box | None:
+        """Box around one visual or collision shape in its link's frame, or None; computed once per
+        shape for every rule that asks (the geometry and consistency rules ask for the same ones)."""
+        key = id(shape)  # the model, and with it every shape, lives as long as this context
+        if key not in self._shape_bounds:
+            self._shape_bounds[key] = shape_bounds(shape)
+        return self._shape_bounds[key]
 
     @property
     def session(self) -> Any:

@@ -92,13 +92,14 @@ def scaled_mesh_bounds(geometry) -> Box | None:
     return tuple(map(min, a, b)), tuple(map(max, a, b))  # type: ignore[return-value]
 
 
-def link_bounds(link) -> Box | None:
+def link_bounds(link, shape_box=shape_bounds) -> Box | None:
     """Box around the link's collision shapes (visual shapes when it has no collision).
 
     None when no shape has a known box, or when one is placed at a non-finite origin (nan/inf:
-    F007 reports the number; a box built from it would mean nothing).
+    F007 reports the number; a box built from it would mean nothing). ``shape_box`` is
+    :func:`shape_bounds` or a cached version of it (the lint context's).
     """
-    boxes = [b for b in (shape_bounds(s) for s in (link.collisions or link.visuals)) if b is not None]
+    boxes = [b for b in (shape_box(s) for s in (link.collisions or link.visuals)) if b is not None]
     if not boxes or not all(all(map(math.isfinite, corner)) for box in boxes for corner in box):
         return None
     lows, highs = zip(*boxes)

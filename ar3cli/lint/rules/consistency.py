@@ -12,7 +12,7 @@ import math
 from collections.abc import Iterator
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
-from ar3cli.urdf.bounds import Box, shape_bounds
+from ar3cli.urdf.bounds import Box
 
 DETACHED_FACTOR = 1.0
 """A child's box further from its parent's box than this many times the larger of the two box
@@ -175,12 +175,12 @@ def _overlap_fraction(inner: Box, outer: Box) -> float:
     return shared / volume if volume > 0 else 1.0
 
 
-def collision_offset(link) -> tuple[float, float, Box, Box] | None:
+def collision_offset(ctx, link) -> tuple[float, float, Box, Box] | None:
     """(covered fraction of the visual box, centre offset in m, visual box, collision box), or None."""
     if not link.visuals or not link.collisions:
         return None
-    visual = _union(shape_bounds(s) for s in link.visuals)
-    collision = _union(shape_bounds(s) for s in link.collisions)
+    visual = _union(ctx.shape_bounds(s) for s in link.visuals)
+    collision = _union(ctx.shape_bounds(s) for s in link.collisions)
     if visual is None or collision is None:
         return None
     centre = [(lo + hi) / 2 for lo, hi in zip(*visual)]
@@ -207,7 +207,7 @@ def _visual_and_collision(collision_xyz: str) -> str:
       references="simcheck 0.2.0 (collision-vs-visual match).")
 def collision_off_visual(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        found = collision_offset(link)
+        found = collision_offset(ctx, link)
         if found is None:
             continue
         covered, offset, visual, _collision = found
@@ -217,25 +217,36 @@ def collision_off_visual(ctx) -> Iterator[Hit]:
 
 
 def _line_box_distance(direction, box: Box) -> float:
-    """Distance from the line through the origin along ``direction`` to ``box`` (convex in the line
-    parameter: a ternary search over the box's extent along the line)."""
+    """Distance from the line through the origin along ``direction`` to ``box``, exactly.
+
+    The squared distance from the point ``t * u`` to the box is a convex, piecewise quadratic function
+    of ``t`` whose pieces meet where the point crosses a face plane (``t = lo / u`` or ``hi / u`` per
+    axis): its minimum is at one of those breakpoints or at a piece's own minimum, clipped into the
+    piece. That is a dozen evaluations (an 80-step ternary search cost G016 a quarter of a cold lint).
+    """
     norm = math.sqrt(sum(v * v for v in direction))
     if not norm > 0:
         return 0.0
     u = [v / norm for v in direction]
-    reach = max(abs(v) for corner in box for v in corner) * 2 + 1.0
+    lows, highs = box
 
     def distance(t: float) -> float:
-        return math.sqrt(sum(max(0.0, lo - t * a, t * a - hi) ** 2 for a, lo, hi in zip(u, *box)))
+        return math.sqrt(sum(max(0.0, lo - t * a, t * a - hi) ** 2 for a, lo, hi in zip(u, lows, highs)))
 
-    low, high = -reach, reach
-    for _ in range(80):
-        m1, m2 = low + (high - low) / 3, high - (high - low) / 3
-        if distance(m1) <= distance(m2):
-            high = m2
-        else:
-            low = m1
-    return distance((low + high) / 2)
+    breaks = sorted({bound / a for a, lo, hi in zip(u, lows, highs) if a != 0 for bound in (lo, hi)})
+    candidates = list(breaks)
+    pieces = list(zip([-math.inf, *breaks], [*breaks, math.inf]))
+    for left, right in pieces:
+        probe = (left + right) / 2 if math.isfinite(left) and math.isfinite(right) else \
+            (right - 1.0 if math.isfinite(right) else left + 1.0)
+        weighted = weight = 0.0
+        for a, lo, hi in zip(u, lows, highs):
+            if lo - probe * a > 0 or probe * a - hi > 0:  # this axis is outside the box over the piece
+                weighted += a * (lo if lo - probe * a > 0 else hi)
+                weight += a * a
+        if weight > 0:
+            candidates.append(min(max(weighted / weight, left), right))
+    return min(map(distance, candidates))
 
 
 def axis_offset(ctx, joint) -> tuple[float, float] | None:

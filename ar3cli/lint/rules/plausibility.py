@@ -11,7 +11,6 @@ import math
 from collections.abc import Iterator
 
 from ar3cli.lint.rules.base import Hit, arm, robot, rule
-from ar3cli.urdf.bounds import shape_bounds
 
 MIN_DENSITY = 50.0
 """kg/m³: lighter than rigid foam (expanded polystyrene is 15-30, but no robot part is made of it
@@ -73,14 +72,14 @@ def _primitive_volume(shape) -> float | None:
     return None
 
 
-def _box_volume(shape) -> float | None:
-    box = shape_bounds(shape)
+def _box_volume(ctx, shape) -> float | None:
+    box = ctx.shape_bounds(shape)
     if box is None:
         return None
     return math.prod(hi - lo for lo, hi in zip(*box))
 
 
-def density_bounds(link) -> tuple[float | None, float | None]:
+def density_bounds(ctx, link) -> tuple[float | None, float | None]:
     """(highest possible density, lowest possible density) in kg/m³ from the link's collision shapes;
     each None when the shapes cannot bound it."""
     mass = link.inertial.mass if link.inertial is not None else None
@@ -91,7 +90,7 @@ def density_bounds(link) -> tuple[float | None, float | None]:
     highest = mass / largest if largest > 0 else None
     volumes = []
     for shapes in (link.collisions, link.visuals):  # the drawn part may be the real one (contact spheres)
-        boxes = [_box_volume(shape) for shape in shapes]
+        boxes = [_box_volume(ctx, shape) for shape in shapes]
         if not boxes or not all(v is not None and v > 0 for v in boxes):
             return highest, None  # a shape of unknown or flat size: no upper bound on the volume
         volumes.append(sum(boxes))  # type: ignore[arg-type]
@@ -121,7 +120,7 @@ def _dense(mass: str, size: str = "0.1 0.1 0.1") -> str:
       references="CRC Handbook of Chemistry and Physics (osmium 22.59 g/cm³); simcheck 0.2.0 (density).")
 def density_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        highest, lowest = density_bounds(link)
+        highest, lowest = density_bounds(ctx, link)
         where = link.inertial.element.find("mass") if link.inertial is not None else None
         if highest is not None and highest < MIN_DENSITY:
             yield Hit(f"link '{link.name}' is at most {highest:.3g} kg/m³ ({link.inertial.mass:g} kg in its collision "

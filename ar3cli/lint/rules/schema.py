@@ -14,6 +14,7 @@ and the few extensions engines read inside URDF elements (:data:`ENGINE_EXTENSIO
 from __future__ import annotations
 
 import difflib
+import functools
 from collections.abc import Iterator
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
@@ -93,8 +94,10 @@ difflib finds them similar (ratio >= 0.6): ``orign``/``origin``, ``xzy``/``xyz``
 is an extension's own attribute, not a misspelt ``effort``."""
 
 
-def _closest(name: str, allowed) -> str | None:
-    """The allowed name ``name`` is a misspelling of, or None."""
+@functools.lru_cache(maxsize=4096)
+def _closest(name: str, allowed: frozenset[str]) -> str | None:
+    """The allowed name ``name`` is a misspelling of, or None (cached: extensions repeat their names
+    on every link, and difflib is the costliest step of the schema rules)."""
     if name in INERTIA_SYMMETRY and INERTIA_SYMMETRY[name] in allowed:
         return INERTIA_SYMMETRY[name]
     candidates = sorted(a for a in allowed if abs(len(a) - len(name)) <= TYPO_LENGTH)
@@ -102,9 +105,10 @@ def _closest(name: str, allowed) -> str | None:
     return matches[0] if matches else None
 
 
-def _home_of(tag: str) -> list[str]:
+@functools.lru_cache(maxsize=1024)
+def _home_of(tag: str) -> tuple[str, ...]:
     """The URDF elements that may hold ``tag`` as a child (for "belongs in <inertial>")."""
-    return [parent for parent, (_attrs, children) in SCHEMA.items() if tag in children and parent != "robot"]
+    return tuple(parent for parent, (_attrs, children) in SCHEMA.items() if tag in children and parent != "robot")
 
 
 def _urdf_elements(root) -> Iterator:
@@ -118,6 +122,11 @@ def _urdf_elements(root) -> Iterator:
         if element.tag == "geometry":
             continue
         stack.extend(child for child in element if _local(child.tag) in children)
+
+
+def _schema_elements(ctx) -> tuple:
+    """:func:`_urdf_elements` of the file, walked once for all the schema rules."""
+    return ctx.shared("schema-elements", lambda model: tuple(_urdf_elements(model.root)))
 
 
 def _owner(element) -> str:
@@ -134,7 +143,7 @@ def _owner(element) -> str:
 
 def _unknown_children(ctx) -> Iterator[tuple]:
     """(element, unknown child, closest allowed name or None) for every child the schema lacks."""
-    for element in (ctx.model.root, *_urdf_elements(ctx.model.root)):
+    for element in (ctx.model.root, *_schema_elements(ctx)):
         attrs, children = SCHEMA[element.tag]
         if element.tag in GEOMETRY_SHAPES_OWNED_ELSEWHERE:
             continue
@@ -195,7 +204,7 @@ def unknown_element(ctx) -> Iterator[Hit]:
       references="wiki.ros.org/urdf/XML (link, joint); urdfdom xsd/urdf.xsd; urdfdom urdf_parser/src/pose.cpp, "
                  "joint.cpp, link.cpp.")
 def unknown_attribute(ctx) -> Iterator[Hit]:
-    for element in (ctx.model.root, *_urdf_elements(ctx.model.root)):
+    for element in (ctx.model.root, *_schema_elements(ctx)):
         attrs = SCHEMA[element.tag][0]
         extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[0]
         for name in element.attrib:
@@ -219,7 +228,7 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
       good=arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><dynamics damping="5"/>'),
       references="Drake issue #18796 (damping as an element silently ignored); urdfdom urdf_parser/src/joint.cpp.")
 def attribute_as_element(ctx) -> Iterator[Hit]:
-    for element in _urdf_elements(ctx.model.root):
+    for element in _schema_elements(ctx):
         attrs = SCHEMA[element.tag][0]
         for child in element:
             tag = _local(child.tag)
@@ -248,7 +257,7 @@ parseInertial: "Inertial element must have a mass element", "... inertia element
       references="urdfdom urdf_parser/src/link.cpp (parseVisual, parseCollision, parseInertial); IsaacSim #599.")
 def missing_required_child(ctx) -> Iterator[Hit]:
     moving = {joint.child for joint in ctx.model.joints if joint.moves}
-    for element in _urdf_elements(ctx.model.root):
+    for element in _schema_elements(ctx):
         required = REQUIRED_CHILDREN.get(element.tag)
         if not required:
             continue
@@ -278,7 +287,7 @@ VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "dec
       references="urdfdom README (URDF versioning) and urdf_parser/src/pose.cpp, joint.cpp; ros/urdfdom#238.")
 def undeclared_urdf_version(ctx) -> Iterator[Hit]:
     model = ctx.model
-    for element in _urdf_elements(model.root):
+    for element in _schema_elements(ctx):
         for name in element.attrib:
             if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
