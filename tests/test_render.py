@@ -91,3 +91,13 @@ def test_nothing_drawable_is_an_error_suggesting_collision(cli, write_urdf, tmp_
                                                                 '<geometry><mesh filename="gone.stl"/></geometry>'))),
                    "-o", str(tmp_path / "r.png"), "--width", "64", "--height", "48")
     assert suggests.code == 0  # the base's collision box is drawn instead
+
+
+def test_many_undrawable_visuals_are_counted_not_listed():
+    """Talos with package:/// has 45 unreadable visuals: stderr gets the first and a count."""
+    from ar3cli.pictures.draw import WARNING_LINES, _warning_lines
+
+    warnings = [f"render: warning: link 'l{i}': a visual cannot be drawn" for i in range(45)]
+    lines = _warning_lines(warnings)
+    assert len(lines) == WARNING_LINES and lines[0] == warnings[0] and "and 44 more visual(s)" in lines[-1]
+    assert _warning_lines(warnings[:2]) == warnings[:2]

@@ -139,6 +139,20 @@ def drawable_visuals(model: Model) -> tuple[Model, list[str]]:
     return overlay, warnings
 
 
+WARNING_LINES = 2
+"""At most this many warning lines on stderr: a robot whose every mesh is unreadable (Talos with
+``package:///``: 45 visuals) gets the first and a count, not a screenful; JSON lists them all."""
+
+
+def _warning_lines(warnings: list[str]) -> list[str]:
+    """``warnings``, or the first ones and one line counting the rest (``visuals_not_drawn`` has them all)."""
+    if len(warnings) <= WARNING_LINES:
+        return warnings
+    shown = warnings[:WARNING_LINES - 1]
+    return [*shown, f"render: warning: and {len(warnings) - len(shown)} more visual(s) cannot be drawn "
+                    "(--format json lists each in visuals_not_drawn)"]
+
+
 def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | None = None,
            width: int = 800, height: int = 600, yaw_deg: float = 45.0, pitch_deg: float = -20.0,
            show_collision: bool = False, show_contacts: bool = True,
@@ -158,8 +172,8 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
     shown, warnings = model, []
     if not show_collision:
         shown, warnings = drawable_visuals(model)
-        for warning in warnings if warn is not None else ():
-            warn(warning)
+        for line in _warning_lines(warnings) if warn is not None else ():
+            warn(line)
         if warnings and shown.root.find("link/visual") is None:
             collision = any(link.collisions for link in model.links)
             raise UserError(f"{model.path}: no visual geometry can be drawn ({len(warnings)} visual(s) left out, see the "
