@@ -14,7 +14,7 @@ import pytest
 from ar3cli.findings import Severity
 from ar3cli.lint.rules.base import LINK_INERTIAL, robot
 from ar3cli.urdf import meshinfo
-from tests.lint_helpers import mesh_link, tensor
+from tests.lint_helpers import findings, mesh_link, tensor
 from tests.test_lint_rules import MESHES, TETRAHEDRON, ascii_stl, binary_stl, codes_for, u_shape_stl, write_fixture
 
 # ---- G010: geometry outside the spec ---------------------------------------------------------------------
@@ -187,3 +187,19 @@ def test_implausible_inertia_is_judged_in_metres_for_an_inch_mesh(tmp_path):
     """I = 1 kg·m² on 1 kg: a radius of gyration of 1 m, 7x a 15 cm cube (but not 6 m, the size in file units)."""
     (finding,) = codes_for(_inch_cube_link(tmp_path, tensor(1, 1, 1)), "I007")
     assert "half-diagonal 0.132 m" in finding.message
+
+
+# ---- G014 leaves a link whose collision alone is off to G015 (alex_nub_hands.urdf, example-robot-data) ----
+
+def test_a_collision_off_its_visual_is_not_blamed_on_the_joint(tmp_path):
+    """alex_nub_hands.urdf's nubs write ``<origin xyz="0 1.57 0" rpy="0 0 0"/>`` in <collision> (rpy typed
+    into xyz): G015 names the collision; G014 blamed the joint's origin, which is right."""
+    part = '<geometry><box size="0.04 0.04 0.04"/></geometry>'
+    path = tmp_path / "nub.urdf"
+    path.write_text(robot(f"""
+        <link name="gripper">{LINK_INERTIAL}<collision><geometry><box size="0.1 0.1 0.15"/></geometry></collision></link>
+        <link name="nub">{LINK_INERTIAL}<visual>{part}</visual>
+          <collision><origin xyz="0 1.57 0" rpy="0 0 0"/>{part}</collision></link>
+        <joint name="attach" type="fixed"><parent link="gripper"/><child link="nub"/><origin xyz="0 0 -0.1"/></joint>"""))
+    rules = [f.rule for f in findings(path) if f.rule in ("G014", "G015")]
+    assert rules == ["G015"]
