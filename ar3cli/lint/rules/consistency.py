@@ -156,9 +156,9 @@ def detached_child(ctx) -> Iterator[Hit]:
             continue
         gap, size, ancestor, joint = found
         if gap > max(DETACHED_MIN_GAP, DETACHED_FACTOR * size) and not collision_off(ctx, link):
-            yield Hit(f"link '{link.name}' sits {gap:.3g} m away from link '{ancestor.name}' (parts about "
-                      f"{size:.3g} m across) at the home pose: joint '{joint.name}' origin "
-                      f"xyz=\"{' '.join(f'{v:g}' for v in joint.origin.xyz)}\" looks wrong",
+            yield Hit(f"joint '{joint.name}' origin xyz=\"{' '.join(f'{v:g}' for v in joint.origin.xyz)}\" looks "
+                      f"wrong: it puts link '{link.name}' {gap:.3g} m away from link '{ancestor.name}' (parts about "
+                      f"{size:.3g} m across) at the home pose",
                       joint.origin.element if joint.origin.element is not None else joint.element)
 
 
