@@ -1,0 +1,25 @@
+"""The :class:`~ar3cli.output.lint_report.LintReport` of the linter's results: what lint-urdf
+renders in its ``--format`` and ``report`` puts on its page. The output layer does not import the
+linter, so the linter's parts (fixers per rule, grouping, the rules that ran) are handed in here."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from ar3cli.output.lint_report import LintReport
+
+
+def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: bool = False, **extra: Any) -> LintReport:
+    """The report of ``results`` (``lint.engine.lint_paths``) and ``summary`` (``summarize``) for
+    ``options`` (``LintOptions``); ``grouped`` folds alike findings into one text row; ``extra``
+    sets the remaining :class:`LintReport` fields (note, changed, fix_commands, exit_zero, wide)."""
+    from ar3cli.commands.finding_context import finding_context
+    from ar3cli.lint.engine import group_findings
+    from ar3cli.lint.fix_hints import fixed_by
+
+    findings = [finding for result in results for finding in result.findings]
+    data = {"files": [result.to_dict() for result in results],
+            "findings": [{**finding.to_dict(), "fixed_by": fixed_by(finding.rule)} for finding in findings],
+            "summary": summary}
+    return LintReport(results, summary, data, options.rules, group=group_findings if grouped else None,
+                      context=finding_context, **extra)
