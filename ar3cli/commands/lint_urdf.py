@@ -42,7 +42,7 @@ from ar3cli.commands.options import (
     XacroMode,
     XacroModeOption,
 )
-from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import finish, finish_as
 from ar3cli.output.report import Report
@@ -90,7 +90,7 @@ def lint_urdf(
                         "(see 'ar3cli lint-urdf --help')")
     if write_baseline is not None and changed_since is not None:
         raise UserError("--write-baseline records every file, so it cannot be combined with --changed-since")
-    from ar3cli.commands.lint_report import lint_report
+    from ar3cli.commands.lint_report import exit_code, lint_report
     from ar3cli.findings import Severity
     from ar3cli.lint.config import LintConfig, load_config
     from ar3cli.lint.engine import LintOptions, lint_paths, summarize
@@ -144,8 +144,7 @@ def lint_urdf(
         results, baselined, unused = apply_baseline(results, accepted)
         held = {"baselined": baselined, "baseline_unused": unused}
     summary = {**summarize(results, threshold), **(held or {})}
-    summary["exit_code"] = EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] and \
-        not exit_zero else 0
+    summary["exit_code"] = exit_code(summary, exit_zero)
     fixes = None
     if fix_hint:
         from ar3cli.lint.fix_hints import fix_commands

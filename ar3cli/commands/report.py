@@ -66,6 +66,7 @@ def report(
     --samples and --seed.
     """
     from ar3cli.commands.finding_context import finding_context
+    from ar3cli.commands.lint_report import lint_document
     from ar3cli.infra.atomic import atomic_write, check_writable
     from ar3cli.output.html import robot_page
     from ar3cli.urdf.loading import load_with_specs
@@ -103,31 +104,6 @@ def _attempt(work: Callable[[], tuple[T, list[str]]], key: str, skipped: dict[st
         skipped[key] = exc.message
         log(f"report: {key} left out: {exc.message}")
         return None, []
-
-
-def lint_document(path: Path, package_path: list[str] | None, xacro_arg: list[str] | None) -> tuple[dict, list]:
-    """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
-    and the findings."""
-    from ar3cli.commands.lint_report import lint_report
-    from ar3cli.errors import EXIT_USAGE
-    from ar3cli.findings import Severity
-    from ar3cli.lint.config import load_config
-    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
-    from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
-
-    config = load_config()
-    try:
-        options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
-                              per_file_ignores=config.per_file_ignores, severity=config.severity,
-                              package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
-    results = lint_paths([path], options)
-    summary = summarize(results, config.fail_on or Severity.ERROR)
-    summary["exit_code"] = EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] else 0
-    made = lint_report(results, summary, options)
-    return made.data, made.findings
 
 
 def _info(model, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict, list[str], list[str]]:
