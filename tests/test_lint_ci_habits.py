@@ -65,8 +65,8 @@ def test_explain_json_has_every_documented_field(cli):
 
 def test_explain_shows_fields_a_rule_may_gain(monkeypatch):
     """--explain reads the Rule generically: a field added later is shown without a change here."""
-    from ar3cli.commands.lint_urdf import explain_text
     from ar3cli.lint.engine import rule_document
+    from ar3cli.output.explain import explain_text
 
     document = {**rule_document(REGISTRY["J001"]), "url": "u", "measured_on": "Talos, TIAGo"}
     assert "Measured on:\n  Talos, TIAGo" in explain_text(document)

@@ -12,7 +12,7 @@ from ar3cli.commands.options import (
     XacroArgOption,
     samples_option,
 )
-from ar3cli.output.report import OutputFormat, finish
+from ar3cli.output.formats import finish
 from ar3cli.urdf.loading import load_with_specs
 
 SamplesOption = Annotated[int, samples_option("Random configurations compared after the home pose.", most=10_000)]
@@ -27,7 +27,7 @@ def cross_check(
     seed: SeedOption = 0,
     stability: StabilityOption = False,
     top: TopOption = 10,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
 ) -> None:
@@ -44,4 +44,4 @@ def cross_check(
 
     import_mujoco()
     model = load_with_specs(path, package_path, xacro_arg)
-    finish(run(model, path, samples, seed, stability, top, announce=format is OutputFormat.text), format)
+    finish(run(model, path, samples, seed, stability, top, announce=format == "text"), format)

@@ -8,22 +8,23 @@ forward kinematics to the diff (feature packages do not import each other).
 
 from __future__ import annotations
 
-import enum
 from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.commands.options import PackagePathOption, SeedOption, XacroArgOption, finite_float, samples_option
+from ar3cli.commands.options import (
+    PackagePathOption,
+    SeedOption,
+    XacroArgOption,
+    finite_float,
+    format_option,
+    samples_option,
+)
 from ar3cli.errors import UserError
-from ar3cli.output.report import finish
+from ar3cli.output.formats import ANNOTATIONS, MARKDOWN, REPORT, finish_as
 
-
-class DiffFormat(str, enum.Enum):
-    text = "text"
-    json = "json"
-    markdown = "markdown"
-    github = "github"
-
+KINDS = (ANNOTATIONS, MARKDOWN, REPORT)
+"""A diff is a table report with a Markdown form and workflow annotations."""
 
 SidesArgument = Annotated[Optional[list[str]], typer.Argument(
     metavar="OLD NEW", show_default=False,
@@ -44,9 +45,7 @@ ToleranceMOption = Annotated[Optional[float], typer.Option(
 ToleranceRadOption = Annotated[Optional[float], typer.Option(
     "--tolerance-rad", show_default=False, click_type=finite_float(),
     help="Angle tolerance (rad); default: --tolerance.")]
-FormatOption = Annotated[DiffFormat, typer.Option(
-    "--format", "-f", help="text (tables), json (one document on stdout), markdown (for a pull-request comment) "
-                           "or github (workflow annotations; the Markdown is appended to $GITHUB_STEP_SUMMARY).")]
+FormatOption = format_option(KINDS, "DiffFormat")
 
 
 def diff(
@@ -59,7 +58,7 @@ def diff(
     tolerance_rad: ToleranceRadOption = None,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
-    format: FormatOption = DiffFormat.text,
+    format: FormatOption = "text",
 ) -> None:
     """Show what NEW changes about OLD's robot: links and joints added, removed or renamed, how far
     every end effector moved (home pose and random configurations) and which joint moved it, masses
@@ -150,17 +149,11 @@ def _lint(model, shown: str) -> list:
     return lint_model(model, shown, options.rules(), options).findings
 
 
-def _finish(diffs, errors: list[str], limits, samples: int, seed: int, fmt: DiffFormat) -> None:
+def _finish(diffs, errors: list[str], limits, samples: int, seed: int, fmt) -> None:
+    """The diff's report, with its Markdown and annotation forms, in the format ``fmt``."""
     from ar3cli.robot_diff.render import annotations, markdown, report
 
     result = report(diffs, limits, samples, seed, errors)
-    if fmt in (DiffFormat.markdown, DiffFormat.github):
-        text = markdown(diffs, samples, seed)
-        if fmt is DiffFormat.github:
-            from ar3cli.output.github import append_step_summary
-
-            failed = append_step_summary(text)
-            result.errors += [failed] if failed else []
-            text = annotations(diffs)
-        result.text, result.tables, result.lines = text, [], []
-    finish(result, "json" if fmt is DiffFormat.json else "text")
+    result.markdown = lambda: markdown(diffs, samples, seed)
+    result.annotations = lambda: annotations(diffs)
+    finish_as(result, KINDS, fmt)

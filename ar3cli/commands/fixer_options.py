@@ -18,7 +18,6 @@ from typing import TYPE_CHECKING, Annotated, Any, NoReturn, Optional
 import typer
 
 from ar3cli.commands.options import FollowSymlinksOption, FormatOption, PackagePathOption, TimeoutOption
-from ar3cli.output.report import OutputFormat
 
 if TYPE_CHECKING:
     from ar3cli.fix.driver import Fixer, FixerArgs
@@ -42,7 +41,7 @@ PATHS = _parameter("paths", FixPathsArgument)
 SHARED = (_parameter("diff", DiffOption, False), _parameter("check", CheckOption, False),
           _parameter("output", OutputOption, None), _parameter("follow_symlinks", FollowSymlinksOption, False),
           _parameter("package_path", PackagePathOption, None),
-          _parameter("format", FormatOption, OutputFormat.text))
+          _parameter("format", FormatOption, "text"))
 """After the command's own options, in this order (``--help`` lists them so)."""
 
 

@@ -20,7 +20,7 @@ from ar3cli.commands.options import (
 )
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
-from ar3cli.output.report import OutputFormat, finish
+from ar3cli.output.formats import finish
 from ar3cli.urdf.loading import load_with_specs
 
 SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
@@ -43,7 +43,7 @@ def fk_verify(
     dh: DhOption = None,
     tolerance_m: ToleranceMOption = None,
     tolerance_rad: ToleranceRadOption = 1e-6,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
@@ -66,6 +66,6 @@ def fk_verify(
                  else Tolerance(tolerance_m, tolerance_rad))
     model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
     table = dh_module.load_dh(dh, model) if dh is not None else None
-    drawn, comparison = measure(model, samples, seed, announce=format is OutputFormat.text)
+    drawn, comparison = measure(model, samples, seed, announce=format == "text")
     checked = check_dh(table, dh, drawn, comparison, tolerance) if table is not None and dh is not None else None
     finish(fk_report(model, path, samples, seed, tolerance, drawn, comparison, checked), format)

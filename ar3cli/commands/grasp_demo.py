@@ -14,7 +14,8 @@ from ar3cli.commands.options import (
     finite_float,
 )
 from ar3cli.errors import UserError
-from ar3cli.output.report import OutputFormat, Report, Table, finish, log
+from ar3cli.output.formats import finish
+from ar3cli.output.report import Report, Table, log
 
 TARGET_RATE = 0.95
 """--trials exits 1 below this success rate (the issue's target on the default region)."""
@@ -35,7 +36,7 @@ def grasp_demo(
                                                       "finger effort, 30 N). Low values make the "
                                                       "grasp slip.")] = 20.0,
     follow_symlinks: FollowSymlinksOption = False,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
 ) -> None:
     """Pick up the cube with the AR3: approach, descend, close, lift 10 cm, hold 1 s.
 
@@ -57,7 +58,7 @@ def grasp_demo(
         def progress(result: Any) -> None:
             log(f"seed {result.seed}: {'success' if result.success else 'FAILED ' + result.failed_phase}")
 
-        outcome = run_trials(seed, trials, settings, progress=progress if format is OutputFormat.text else None)
+        outcome = run_trials(seed, trials, settings, progress=progress if format == "text" else None)
         ok = outcome.success_rate >= TARGET_RATE
         finish(trials_report(outcome, ok), format)
 

@@ -21,7 +21,7 @@ from ar3cli.commands.options import (
 )
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
-from ar3cli.output.report import OutputFormat, finish
+from ar3cli.output.formats import finish
 from ar3cli.urdf.loading import load_with_specs
 
 TorquesOption = Annotated[bool, typer.Option(
@@ -46,7 +46,7 @@ def info(
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Show what a robot is made of: kinematic tree, DOF and joint limits, masses and centre of mass,
@@ -78,7 +78,7 @@ def info(
         from ar3cli.infra.atomic import atomic_write
 
         atomic_write(png, tree_png(summary))
-    finish(report(summary, tree=format is OutputFormat.text, torques=check,
+    finish(report(summary, tree=format == "text", torques=check,
                   picture=None if png is None else str(png)), format)
 
 

@@ -2,10 +2,11 @@
 
 
 from ar3cli.commands.options import FormatOption
-from ar3cli.output.report import OutputFormat, Report, Table, finish
+from ar3cli.output.formats import finish
+from ar3cli.output.report import Report, Table
 
 
-def install_check(format: FormatOption = OutputFormat.text) -> None:
+def install_check(format: FormatOption = "text") -> None:
     """Check that Python, PyBullet and ar3cli's libraries are installed and behave.
 
     Each check prints ok / warn / fail / info, a detail, and for problems the exact command to run.

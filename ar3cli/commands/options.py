@@ -10,12 +10,16 @@ from typing import Annotated, Any, Optional
 
 import typer
 
-from ar3cli.output.report import OutputFormat
+from ar3cli.output.formats import REPORT, choices, help_text
 
-FormatOption = Annotated[
-    OutputFormat,
-    typer.Option("--format", "-f", help="Output format: a table for people, or one JSON document on stdout."),
-]
+
+def format_option(kinds: tuple[str, ...], enum_name: str) -> Any:
+    """``--format/-f`` of a command whose report is of ``kinds`` (most specific first): its choices
+    and their help are the formats of :mod:`ar3cli.output.formats` that render those kinds."""
+    return Annotated[choices(kinds, enum_name), typer.Option("--format", "-f", help=help_text(kinds))]
+
+
+FormatOption = format_option((REPORT,), "ReportFormat")
 PackagePathOption = Annotated[
     Optional[list[str]],
     typer.Option("--package-path", metavar="NAME=DIR",

@@ -18,7 +18,8 @@ from ar3cli.commands.options import (
     finite_float,
 )
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
-from ar3cli.output.report import OutputFormat, Report, Table, finish, log
+from ar3cli.output.formats import finish
+from ar3cli.output.report import Report, Table, log
 from ar3cli.urdf.loading import load_with_specs
 
 
@@ -41,7 +42,7 @@ def render_command(
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Draw the model at its home pose (or --config) to a PNG with PyBullet's CPU renderer.

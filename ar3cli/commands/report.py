@@ -31,7 +31,8 @@ from ar3cli.commands.options import (
 )
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
-from ar3cli.output.report import OutputFormat, Report, finish, log
+from ar3cli.output.formats import finish
+from ar3cli.output.report import Report, log
 
 T = TypeVar("T")
 VIEWS = (("front", 0.0, -10.0), ("side", 90.0, -10.0), ("top", 0.0, -89.0))
@@ -53,7 +54,7 @@ def report(
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,
     xacro_env: XacroEnvOption = None,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Write one self-contained HTML page about a robot: summary, kinematic tree, pictures from three
@@ -65,6 +66,7 @@ def report(
     --samples and --seed.
     """
     from ar3cli.commands.finding_context import finding_context
+    from ar3cli.commands.lint_report import lint_document
     from ar3cli.infra.atomic import atomic_write, check_writable
     from ar3cli.output.html import robot_page
     from ar3cli.urdf.loading import load_with_specs
@@ -102,30 +104,6 @@ def _attempt(work: Callable[[], tuple[T, list[str]]], key: str, skipped: dict[st
         skipped[key] = exc.message
         log(f"report: {key} left out: {exc.message}")
         return None, []
-
-
-def lint_document(path: Path, package_path: list[str] | None, xacro_arg: list[str] | None) -> tuple[dict, list]:
-    """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
-    and the findings."""
-    from ar3cli.commands.lint_urdf import LintFormat, render_lint
-    from ar3cli.errors import EXIT_USAGE
-    from ar3cli.findings import Severity
-    from ar3cli.lint.config import load_config
-    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
-    from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
-
-    config = load_config()
-    try:
-        options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
-                              per_file_ignores=config.per_file_ignores, severity=config.severity,
-                              package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
-    results = lint_paths([path], options)
-    summary = summarize(results, config.fail_on or Severity.ERROR)
-    summary["exit_code"] = EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] else 0
-    return render_lint(results, summary, options, LintFormat.json).data, [f for r in results for f in r.findings]
 
 
 def _info(model, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict, list[str], list[str]]:
@@ -184,7 +162,7 @@ def _collisions(model, samples: int, seed: int) -> tuple[dict, list[str]]:
     from ar3cli.collisions.report import matrix_report
     from ar3cli.collisions.run import sample_matrix
 
-    made = matrix_report(model, sample_matrix(model, samples, seed, None, 0.95), OutputFormat.text)
+    made = matrix_report(model, sample_matrix(model, samples, seed, None, 0.95), "text")
     return made.data, made.lines
 
 

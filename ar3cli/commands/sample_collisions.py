@@ -21,7 +21,7 @@ from ar3cli.commands.options import (
 )
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import LONG_TIMEOUT_S
-from ar3cli.output.report import OutputFormat, finish
+from ar3cli.output.formats import finish
 from ar3cli.urdf.loading import load_with_specs
 
 SamplesOption = Annotated[int, samples_option("Uniform random configurations to check (MoveIt's default: 10000).",
@@ -68,7 +68,7 @@ def sample_collisions(
     pybullet_filter: FilterOption = None,
     png: PngOption = None,
     follow_symlinks: FollowSymlinksOption = False,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     xacro: XacroModeOption = XacroMode.safe,

@@ -12,7 +12,8 @@ from typing import Annotated, Optional
 import typer
 
 from ar3cli.commands.options import FormatOption, PackagePathOption, XacroArgOption, finite_float
-from ar3cli.output.report import OutputFormat, Report, finish
+from ar3cli.output.formats import finish
+from ar3cli.output.report import Report
 
 
 class BackendName(str, enum.Enum):
@@ -50,7 +51,7 @@ def scan(
     = False,
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
-    format: FormatOption = OutputFormat.text,
+    format: FormatOption = "text",
 ) -> None:
     """Lint every robot file under ROOT into a SQLite store, one row per file; a second run checks
     only new or changed files. Interrupt it at any time: the next run goes on from there.
@@ -86,7 +87,7 @@ def scan(
     settings = ScanSettings(functools.partial(lint_for_scan, options=options), settings_key(options),
                             options.package_paths, options.xacro_args, os.getcwd())
     summary = run_scan(files, store, settings, Backend(backend.value, jobs, timeout, address), rescan)
-    if report and format is OutputFormat.text:
+    if report and format == "text":
         from ar3cli.commands.scan_report import store_report
 
         finish(store_report(store, top=10), "text")

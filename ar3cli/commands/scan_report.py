@@ -1,18 +1,17 @@
 """``ar3cli scan-report``: counts, worst files and a keep-list from a scan store."""
 
-import enum
 from pathlib import Path
 from typing import Annotated, Optional
 
 import typer
 
-from ar3cli.output.report import Report, finish
+from ar3cli.commands.options import format_option
+from ar3cli.output.formats import MARKDOWN, REPORT, finish_as
+from ar3cli.output.report import Report, log
 
-
-class ReportFormat(str, enum.Enum):
-    text = "text"
-    json = "json"
-    markdown = "markdown"
+KINDS = (MARKDOWN, REPORT)
+"""A scan summary is a table report with a Markdown form."""
+FormatOption = format_option(KINDS, "ScanReportFormat")
 
 
 def scan_report(
@@ -27,8 +26,7 @@ def scan_report(
                                                       help="Write the kept files' paths to FILE, one a line.",
                                                       show_default=False)] = None,
     top: Annotated[int, typer.Option("--top", min=0, max=10_000, help="How many of the worst files to list.")] = 10,
-    format: Annotated[ReportFormat, typer.Option("--format", "-f", help="text (tables), json or markdown.")]
-    = ReportFormat.text,
+    format: FormatOption = "text",
 ) -> None:
     """Sum up a scan store: files by status, findings by rule, the worst files, and the files a
     keep filter keeps (written to --keep-list for a training run).
@@ -36,19 +34,22 @@ def scan_report(
     Exit codes: 0 ok, 2 usage or I/O error.
     """
     filters = keep if keep else (["no-errors"] if keep_list is not None else [])
-    report = store_report(store, top, filters, ReportFormat(format))
+    report = store_report(store, top, filters)
     if keep_list is not None:
         from ar3cli.infra.atomic import atomic_write
 
         paths = report.data["keep"]["paths"]
         atomic_write(keep_list, "".join(f"{path}\n" for path in paths).encode("utf-8", "surrogateescape"))
-        report.lines.append(f"wrote {len(paths)} paths to {keep_list}")
-    finish(report, "json" if format is ReportFormat.json else "text")
+        wrote = f"wrote {len(paths)} paths to {keep_list}"
+        if format == "markdown":
+            log(wrote)  # the Markdown alone on stdout, this line on stderr
+        else:
+            report.lines.append(wrote)
+    finish_as(report, KINDS, format)
 
 
-def store_report(store: Path, top: int, filters: list[str] | None = None,
-                 fmt: ReportFormat = ReportFormat.text) -> Report:
-    """The report of ``store`` in ``fmt`` (the JSON document is ``Report.data`` in every format)."""
+def store_report(store: Path, top: int, filters: list[str] | None = None) -> Report:
+    """The report of ``store``: its JSON document, tables and keep line, and its Markdown form."""
     from ar3cli.scan.keep import parse_keep
     from ar3cli.scan.report import keep_line, markdown, summarize, tables
     from ar3cli.scan.store import Store
@@ -56,6 +57,4 @@ def store_report(store: Path, top: int, filters: list[str] | None = None,
     parsed = [parse_keep(text) for text in filters or []]
     with Store(store, readonly=True) as opened:
         data = summarize(list(opened.rows()), parsed, top)
-    if fmt is ReportFormat.markdown:
-        return Report(data=data, text=markdown(data))
-    return Report(data=data, tables=tables(data), lines=[keep_line(data)])
+    return Report(data=data, tables=tables(data), lines=[keep_line(data)], markdown=lambda: markdown(data))

@@ -42,6 +42,27 @@ class ChangedSelection:
         return {"ref": self.ref, "changed": self.changed, "dependents": self.dependents,
                 "robot_files_under_paths": self.candidates}
 
+    def note(self) -> str:
+        """What --changed-since picked, in one line (lint-urdf's first text line, else on stderr)."""
+        head = f"--changed-since {self.ref}:"
+        if not self.files:
+            return (f"{head} no robot file under PATH changed or uses a changed file "
+                    f"({self.candidates} not checked); nothing to check")
+        parts = []
+        if self.changed:
+            parts.append(f"{len(self.changed)} changed ({_names(self.changed)})")
+        if self.dependents:
+            count = len(self.dependents)
+            parts.append(f"{count} use{'s' if count == 1 else ''} a changed file ("
+                         + _names([f"{robot} uses {', '.join(used)}" for robot, used in self.dependents.items()])
+                         + ")")
+        return f"{head} {len(self.files)} of {self.candidates} robot files: {'; '.join(parts)}"
+
+
+def _names(items: list[str], shown: int = 3) -> str:
+    """The first ``shown`` items, and how many more."""
+    return ", ".join(items[:shown]) + (f", and {len(items) - shown} more" if len(items) > shown else "")
+
 
 def select_changed(paths: Iterable[Path], ref: str, package_paths: Mapping[str, Path] | None = None,
                    xacro_args: Mapping[str, str] | None = None) -> ChangedSelection:

@@ -10,7 +10,8 @@ line per row everywhere. Names from robot files (paths, links, joints) reach tex
 override) is shown as ``\\x1b``, never obeyed by the terminal; JSON keeps the exact strings. JSON goes to stdout alone, so
 ``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing to write
 the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
-Lint's extra formats (sarif, github, markdown) live in their own modules and use the same Report.
+Which formats a user can choose, and which reports each renders, is the registry of
+:mod:`ar3cli.output.formats`; every format ends here, writing the Report it made as text or JSON.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ import math
 import os
 import re
 import sys
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, NoReturn, TextIO
 
@@ -28,7 +30,9 @@ from ar3cli.errors import EXIT_USAGE, UserError
 
 
 class OutputFormat(str, enum.Enum):
-    """Formats every command supports."""
+    """How a Report is written (:func:`finish`): text (tables and lines, or the verbatim text) or
+    json (``Report.data`` alone on stdout). The ``--format`` a user chooses is a format of the
+    registry (:mod:`ar3cli.output.formats`), and each writes its Report in one of these two ways."""
 
     text = "text"
     json = "json"
@@ -73,6 +77,10 @@ class Report:
     reported: written to stderr as ``ar3cli: error: ...`` in every format, and the exit code is 2."""
     wide: bool = False
     """Text tables one line per row whatever the width (``--wide``): for grep and wide log viewers."""
+    markdown: Callable[[], str] | None = None
+    """The report as Markdown (``--format markdown``), for a command whose report has that form."""
+    annotations: Callable[[], str] | None = None
+    """GitHub workflow annotations (``--format github``), for a command whose report has them."""
 
 
 def console(stderr: bool = False):
@@ -342,7 +350,7 @@ def render_report(report: Report, fmt: OutputFormat | str) -> None:
 
 
 def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:
-    """Render ``report`` and end the command: exit 2 when it carries :attr:`Report.errors`, else 0
+    """Write ``report`` as text or json (``fmt``) and end the command: exit 2 when it carries :attr:`Report.errors`, else 0
     when ``report.ok``, else 1 (problems found)."""
     import typer
 

@@ -1,0 +1,120 @@
+"""lint-urdf's own options, typed once with ``Annotated``, and the functions that turn their values
+into the linter's settings (the shared ones are in ``options.py``)."""
+
+from __future__ import annotations
+
+import enum
+from pathlib import Path
+from typing import Annotated, Optional
+
+import typer
+
+from ar3cli.commands.options import format_option
+from ar3cli.errors import UserError
+from ar3cli.output.formats import LINT
+
+
+class Engine(str, enum.Enum):
+    """Simulators ``--sim`` runs."""
+
+    pybullet = "pybullet"
+    mujoco = "mujoco"
+    all = "all"
+
+
+class FailOn(str, enum.Enum):
+    error = "error"
+    warning = "warning"
+    info = "info"
+
+
+KINDS = (LINT,)
+"""lint-urdf's report: lint findings (every format that renders them)."""
+LintFormatOption = format_option(KINDS, "LintFormat")
+PathsArgument = Annotated[Optional[list[Path]], typer.Argument(
+    metavar="PATH", help="URDF/xacro files, or folders searched for *.urdf and *.xacro (required, "
+                         "except with --explain).", show_default=False)]
+SelectOption = Annotated[Optional[list[str]], typer.Option(
+    "--select", metavar="CODES",
+    help="Only these rule codes or prefixes (comma-separated, repeatable; overrides the config's select).")]
+IgnoreOption = Annotated[Optional[list[str]], typer.Option(
+    "--ignore", metavar="CODES", help="Skip these rule codes or prefixes (added to the config's ignore).")]
+FailOnOption = Annotated[Optional[FailOn], typer.Option(
+    "--fail-on", help="Exit 1 when a finding is at least this severe (default: error, or the config's fail-on).",
+    show_default=False)]
+ExitZeroOption = Annotated[bool, typer.Option("--exit-zero", help="Exit 0 even when there are findings.")]
+SimOption = Annotated[bool, typer.Option(
+    "--sim", help="Also load each model in PyBullet (P rules): load errors, self-collision at home, inertia "
+                  "PyBullet really uses, stability.")]
+EngineOption = Annotated[Engine, typer.Option(
+    "--engine", help="With --sim: the simulator(s) to check in: PyBullet (P rules), MuJoCo (M rules: compile, "
+                     "unreadable meshes, contacts at home, 1 s under gravity; needs pip install 'ar3cli[mujoco]'), "
+                     "or all.")]
+NoConfigOption = Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
+JobsOption = Annotated[Optional[int], typer.Option(
+    "--jobs", "-j", min=1, show_default=False,
+    help="Processes that share the files, at most one per CPU. Default on Linux: one per 24 files (per 2 with "
+         "--sim), at most 8; elsewhere 1. The output is the same for any value.")]
+NoCacheOption = Annotated[bool, typer.Option(
+    "--no-cache", help="Check every file again instead of reusing the findings of unchanged files from earlier "
+                       "runs (also AR3CLI_NO_CACHE=1).")]
+FixHintOption = Annotated[bool, typer.Option(
+    "--fix-hint", help="After the findings, print the ar3cli command lines that fix them, one per fixer and file "
+                       "(JSON: fix_commands).")]
+GroupOption = Annotated[Optional[bool], typer.Option(
+    "--group/--no-group", help="Text format: show 5 or more alike findings of one rule in one file as one row "
+                               "(count, first locations, message); on by default. JSON, SARIF, github and markdown "
+                               "keep every finding.", show_default=False)]
+WideOption = Annotated[bool, typer.Option(
+    "--wide", help="Text format: one line per finding, however wide (for grep and wide log viewers). By default "
+                   "tables fit the terminal (or COLUMNS) and wrap messages; piped without COLUMNS, they are one "
+                   "line per row anyway.")]
+BaselineOption = Annotated[Optional[Path], typer.Option(
+    "--baseline", metavar="FILE", help="Do not report (or fail on) the findings this baseline file holds; only new "
+                                       "ones count.", show_default=False)]
+WriteBaselineOption = Annotated[Optional[Path], typer.Option(
+    "--write-baseline", metavar="FILE", help="Write every finding of this run to FILE as the baseline (for "
+                                             "--baseline) and exit 0.", show_default=False)]
+ChangedSinceOption = Annotated[Optional[str], typer.Option(
+    "--changed-since", metavar="REF", help="Only the robot files under PATH changed since this git ref (and "
+                                           "untracked ones), and those using a changed mesh or included xacro file.",
+    show_default=False)]
+ExplainOption = Annotated[Optional[str], typer.Option(
+    "--explain", metavar="CODE", help="Print a rule's documentation (why, fix, examples) and exit; takes no PATH.",
+    show_default=False)]
+SrdfOption = Annotated[Optional[Path], typer.Option(
+    "--srdf", metavar="FILE.srdf", dir_okay=False,
+    help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
+TargetOption = Annotated[Optional[list[str]], typer.Option(
+    "--target", metavar="ENGINES",
+    help="Engines the robot is meant for (comma-separated or repeated: pybullet, ros, mujoco, isaac, drake, "
+         "gazebo): adds each one's known traps (T rules). Default: pybullet,ros.", show_default=False)]
+
+
+def split_codes(items: list[str] | None) -> list[str]:
+    """``--select``/``--ignore`` values, each comma-separated, as one list."""
+    return [part for item in items or [] for part in item.split(",")]
+
+
+def parse_targets(values: list[str] | None) -> tuple[str, ...]:
+    """The --target engines, validated (default: pybullet and ros)."""
+    from ar3cli.lint.rules.targets import DEFAULT_TARGETS, TARGETS
+
+    if not values:
+        return DEFAULT_TARGETS
+    names = tuple(dict.fromkeys(name.strip().lower() for value in values for name in value.split(",") if name.strip()))
+    unknown = [name for name in names if name not in TARGETS]
+    if unknown:
+        raise UserError(f"--target: unknown engine {unknown[0]!r} (known: {', '.join(TARGETS)})")
+    return names
+
+
+def srdf_disabled(srdf: Path | None, sim: bool) -> frozenset[frozenset[str]]:
+    """The pairs ``--srdf`` disables; it only matters with ``--sim`` (a one-line error without)."""
+    if srdf is None:
+        return frozenset()
+    if not sim:
+        raise UserError("--srdf only changes the --sim checks (P002, contact at the home pose): add --sim")
+    from ar3cli.urdf.srdf import disabled_pairs
+
+    return disabled_pairs(srdf)

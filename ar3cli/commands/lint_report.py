@@ -1,0 +1,55 @@
+"""The :class:`~ar3cli.output.lint_report.LintReport` of the linter's results: what lint-urdf
+renders in its ``--format`` and ``report`` puts on its page (:func:`lint_document`). The output layer does not import the
+linter, so the linter's parts (fixers per rule, grouping, the rules that ran) are handed in here."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.output.lint_report import LintReport
+
+
+def exit_code(summary: dict[str, Any], exit_zero: bool = False) -> int:
+    """The exit code a lint run with ``summary`` ends with (2 when a file was not checked)."""
+    return EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] and not exit_zero else 0
+
+
+def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: bool = False, **extra: Any) -> LintReport:
+    """The report of ``results`` (``lint.engine.lint_paths``) and ``summary`` (``summarize``) for
+    ``options`` (``LintOptions``); ``grouped`` folds alike findings into one text row; ``extra``
+    sets the remaining :class:`LintReport` fields (note, changed, fix_commands, exit_zero, wide)."""
+    from ar3cli.commands.finding_context import finding_context
+    from ar3cli.lint.engine import group_findings
+    from ar3cli.lint.fix_hints import fixed_by
+
+    findings = [finding for result in results for finding in result.findings]
+    data = {"files": [result.to_dict() for result in results],
+            "findings": [{**finding.to_dict(), "fixed_by": fixed_by(finding.rule)} for finding in findings],
+            "summary": summary}
+    return LintReport(results, summary, data, options.rules, group=group_findings if grouped else None,
+                      context=finding_context, **extra)
+
+
+def lint_document(path: Path, package_path: list[str] | None, xacro_arg: list[str] | None) -> tuple[dict, list]:
+    """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
+    and the findings."""
+    from ar3cli.findings import Severity
+    from ar3cli.lint.config import load_config
+    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
+    from ar3cli.urdf.packages import parse_package_paths
+    from ar3cli.urdf.xacro_expand import parse_xacro_args
+
+    config = load_config()
+    try:
+        options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
+                              per_file_ignores=config.per_file_ignores, severity=config.severity,
+                              package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
+    results = lint_paths([path], options)
+    summary = summarize(results, config.fail_on or Severity.ERROR)
+    summary["exit_code"] = exit_code(summary)
+    made = lint_report(results, summary, options)
+    return made.data, made.findings

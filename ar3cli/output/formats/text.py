@@ -1,0 +1,33 @@
+"""``--format text``: tables and lines for people (every report); lint findings one table per file."""
+
+from __future__ import annotations
+
+from ar3cli.findings import Finding
+from ar3cli.output.formats import LINT, REPORT, Format, register
+from ar3cli.output.lint_report import LintReport, completed, summary_line
+from ar3cli.output.report import Report, Table
+
+
+def lint_text(lint: LintReport) -> Report:
+    """One table per file with findings (alike findings folded into one row when ``lint.group``),
+    then the verdict; with ``--changed-since`` and nothing to check, only its note."""
+    if lint.note is not None and not lint.results:
+        return completed(lint, Report(data={}), text=True, hints=True)
+    tables = [Table(title=result.path, columns=["location", "code", "severity", "message", "hint"],
+                    rows=_rows(result.findings, lint), status_column="severity", nowrap_columns=("location",))
+              for result in lint.results if result.findings]
+    cached = sum(result.cached for result in lint.results)
+    report = Report(data=lint.data, tables=tables, lines=[summary_line(lint.summary, cached)], ok=lint.ok)
+    return completed(lint, report, text=True, hints=True)
+
+
+def _rows(findings: list[Finding], lint: LintReport) -> list[list]:
+    """Table rows: one per finding, or per group of alike findings (``first`` and ``message``)."""
+    rows = []
+    for row in lint.group(findings) if lint.group else findings:
+        first = row if isinstance(row, Finding) else row.first
+        rows.append([first.location, first.rule, first.severity.value, row.message, first.hint])
+    return rows
+
+
+FORMAT = register(Format("text", "tables for people", {REPORT: lambda report: report, LINT: lint_text}, order=0))

@@ -1,0 +1,92 @@
+"""What every lint format renders: :class:`LintReport` (the ``lint`` kind of
+:mod:`ar3cli.output.formats`), the verdict line, and the steps every lint format ends with.
+
+The output layer does not import the linter: the command hands in the per-file results and the
+few things only the linter knows (the rules that ran, how alike findings are grouped, an HTML
+page's source lines) as values and functions.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+from ar3cli.findings import Finding
+from ar3cli.output.report import Report, log
+
+
+@dataclass
+class LintReport:
+    """A lint run, before it is given a format.
+
+    ``results`` are the linter's per-file results (``path``, ``findings``, ``error``, ``cached`` and
+    ``to_dict()``); ``data`` is the JSON document (``files``, ``findings`` with ``fixed_by``,
+    ``summary``), which the json format prints and the html page embeds.
+    """
+
+    results: list[Any]
+    summary: dict[str, Any]
+    data: dict[str, Any]
+    rules: Callable[[], list[Any]]
+    """The rules that ran (SARIF's ``tool.driver.rules``)."""
+    group: Callable[[list[Finding]], list[Any]] | None = None
+    """Folds alike findings of the text table into one row (``--group``); None: a row each."""
+    context: Callable[[list[Finding]], dict[str, Any]] = lambda findings: {}
+    """What the html page shows with each finding (source lines, fix commands)."""
+    note: str | None = None
+    """``--changed-since``'s line: the first text line, on stderr in the other formats."""
+    changed: dict[str, Any] | None = None
+    """``--changed-since``'s selection, added to the JSON (and SARIF) document."""
+    fix_commands: list[str] | None = None
+    """``--fix-hint``: the fixer command lines (text and json only)."""
+    exit_zero: bool = False
+    wide: bool = False
+    findings: list[Finding] = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.findings = [finding for result in self.results for finding in result.findings]
+
+    @property
+    def ok(self) -> bool:
+        """No finding at or above the fail-on severity (a file not checked is exit 2 through
+        ``Report.errors``, not 1)."""
+        return not self.summary["findings_failing"]
+
+
+def summary_line(summary: dict, cached: int = 0) -> str:
+    """The verdict line; ``cached`` files answered from the result cache are said when there are any."""
+    files = summary["files"]
+    broken = summary["files_not_checked"]
+    clean = summary["files_clean"]
+    verdict = "FAILED" if summary["failed"] else "passed"
+    unchecked = f"; {broken} not fully checked (pybullet crashed, or ran out of time or memory)" if broken else ""
+    remembered = f"; {cached} unchanged since an earlier run (from the cache)" if cached else ""
+    held = ""
+    if summary.get("baselined") is not None:
+        unused = summary.get("baseline_unused") or 0
+        held = f"; {summary['baselined']} baselined" + (
+            f" ({unused} more in the baseline no longer found: --write-baseline drops them)" if unused else "")
+    return (f"{verdict}: {files} file{'s' if files != 1 else ''} checked, {summary['error']} errors, "
+            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{held}{unchecked}{remembered} "
+            f"(fail-on: {summary['fail_on']})")
+
+
+def completed(lint: LintReport, report: Report, *, text: bool = False, hints: bool = False) -> Report:
+    """What every lint format ends with: the ``--changed-since`` selection and note (the first
+    line of ``text`` output, else on stderr), ``--fix-hint``'s lines when the format shows
+    ``hints``, ``--exit-zero``, ``--wide``, and one error per file that could not be checked."""
+    if lint.changed is not None:
+        report.data["changed_since"] = lint.changed
+    if lint.note is not None:
+        if text:
+            report.lines.insert(0, lint.note)
+        else:
+            log(lint.note)
+    if hints and lint.fix_commands is not None:
+        report.data["fix_commands"] = lint.fix_commands
+        report.lines += [f"to fix: {line}" for line in lint.fix_commands] or ["to fix: no finding has an ar3cli fixer"]
+    report.ok = report.ok or lint.exit_zero
+    report.wide = lint.wide
+    report.errors = [*report.errors, *(result.error for result in lint.results if result.error)]
+    return report
