@@ -68,7 +68,7 @@ def test_github_annotations_escape_properties_and_data(cli, write_urdf):
 
 
 def test_github_escape_functions():
-    from ar3cli.output.github import escape_data, escape_property
+    from ar3cli.output.github_actions import escape_data, escape_property
 
     assert escape_data("50%\r\nnext") == "50%25%0D%0Anext"
     assert escape_property("a:b,c%") == "a%3Ab%2Cc%25"

@@ -63,7 +63,7 @@ def report(diffs: Sequence[RobotDiff], tolerance: Tolerance, samples: int, seed:
 
 
 def _cell(value: Any) -> str:
-    from ar3cli.output.github import markdown_cell
+    from ar3cli.output.markdown_table import markdown_cell
 
     return markdown_cell(value if isinstance(value, str) else show(value))
 
@@ -97,7 +97,7 @@ def markdown(diffs: Sequence[RobotDiff], samples: int, seed: int) -> str:
 def annotations(diffs: Sequence[RobotDiff]) -> str:
     """``::warning file=F,line=L,title=ar3cli diff::...`` per change and moved end effector, ``::notice``
     per lint finding that came or went. Changes located only in a revision (``REV:path``) get no file."""
-    from ar3cli.output.github import escape_data, escape_property
+    from ar3cli.output.github_actions import escape_data, escape_property
 
     def line(kind: str, file: str, number: int, title: str, message: str) -> str:
         properties = [f"file={escape_property(file)}"] if file and ":" not in file else []

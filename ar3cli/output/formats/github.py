@@ -12,7 +12,8 @@ from ar3cli.output.report import Report
 
 def lint_github(lint: LintReport) -> Report:
     """One annotation per finding, then the verdict."""
-    from ar3cli.output.github import annotation, append_step_summary, markdown_table
+    from ar3cli.output.github_actions import annotation, append_step_summary
+    from ar3cli.output.markdown_table import markdown_table
 
     verdict = summary_line(lint.summary)
     error = append_step_summary(markdown_table(lint.findings, verdict))
@@ -23,7 +24,7 @@ def lint_github(lint: LintReport) -> Report:
 
 def annotated(report: Report) -> Report:
     """A report that has annotations and a Markdown form (``Report.annotations``, ``Report.markdown``)."""
-    from ar3cli.output.github import append_step_summary
+    from ar3cli.output.github_actions import append_step_summary
 
     assert report.annotations is not None and report.markdown is not None
     failed = append_step_summary(report.markdown())

@@ -11,7 +11,7 @@ from ar3cli.output.report import Report
 
 def lint_markdown(lint: LintReport) -> Report:
     """The findings as a Markdown table, then the verdict."""
-    from ar3cli.output.github import markdown_table
+    from ar3cli.output.markdown_table import markdown_table
 
     return completed(lint, Report(data=lint.data, text=markdown_table(lint.findings, summary_line(lint.summary)),
                                   ok=lint.ok))

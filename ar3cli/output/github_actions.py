@@ -1,8 +1,8 @@
-"""GitHub Actions workflow-command annotations and a Markdown table for ``$GITHUB_STEP_SUMMARY``.
+"""GitHub Actions: workflow-command annotations (``::error file=...::``) and the run's step summary
+(``$GITHUB_STEP_SUMMARY``).
 
 Paths, messages and hints go through :func:`~ar3cli.output.report.printable` first: a link named
-with an escape sequence must not repaint the CI log, and a bidi override must not reorder a
-reviewer's summary page.
+with an escape sequence must not repaint the CI log.
 """
 
 from __future__ import annotations
@@ -33,24 +33,6 @@ def annotation(finding: Finding) -> str:
     properties.append(f"title={escape_property(printable(finding.rule))}")
     message = finding.message + (f" (fix: {finding.hint})" if finding.hint else "")
     return f"::{COMMANDS[finding.severity]} {','.join(properties)}::{escape_data(printable(message))}"
-
-
-def markdown_cell(text: str) -> str:
-    """Text safe inside a table cell: pipes escaped, and ``<inertial>`` shown, not eaten as an HTML tag."""
-    text = printable(text).replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
-    return text.replace("\\", "\\\\").replace("|", "\\|").replace("\r", " ").replace("\n", " ")
-
-
-def markdown_table(findings: list[Finding], summary_line: str) -> str:
-    """A findings table in GitHub-flavoured Markdown, ending with the summary line."""
-    lines = ["## ar3cli lint-urdf", ""]
-    if findings:
-        lines += ["| location | rule | severity | message | hint |", "| --- | --- | --- | --- | --- |"]
-        lines += [f"| `{markdown_cell(f.location)}` | {f.rule} | {f.severity.value} | {markdown_cell(f.message)} | "
-                  f"{markdown_cell(f.hint)} |" for f in findings]
-        lines.append("")
-    lines.append(printable(summary_line))
-    return "\n".join(lines) + "\n"
 
 
 def append_step_summary(markdown: str) -> str | None:
