@@ -160,5 +160,44 @@ def test_the_documented_diagram_is_the_code() -> None:
         "docs/architecture.md is stale: python tests/test_architecture.py prints the diagram"
 
 
+def _resolves(dotted: str) -> bool:
+    """Whether ``a.b.C`` names a module of ar3cli (or of one of its packages) and an attribute in it."""
+    import importlib
+
+    parts = dotted.split(".")
+    prefixes = ["ar3cli"] + [f"ar3cli.{p.relative_to(PACKAGE).as_posix().replace('/', '.')}"
+                             for p in PACKAGE.rglob("*") if p.is_dir() and (p / "__init__.py").exists()]
+    for prefix in prefixes:
+        for split in range(len(parts), 0, -1):
+            try:
+                target = importlib.import_module(".".join([prefix, *parts[:split]]))
+            except ImportError:
+                continue
+            for name in parts[split:]:
+                target = getattr(target, name, None)
+            if target is not None:
+                return True
+    return False
+
+
+def test_every_name_and_path_the_architecture_doc_cites_exists() -> None:
+    """The registration statements ("the decorator registers it in ``lint.rules.REGISTRY``", "one line in
+    ``cli.COMMANDS``", "``FIXER = Fixer(...)`` in ``fix/NAME_plan.py``") stay true: every dotted name
+    in backticks resolves to something in ar3cli and every cited file or folder exists."""
+    text = DOC.read_text(encoding="utf-8")
+    names = set(re.findall(r"`([a-z_]+(?:\.[A-Za-z_]+)+)`", text))
+    files = {n for n in names if n.endswith((".py", ".yaml", ".md"))}
+    missing = [n for n in sorted(names - files) if not _resolves(n)]
+    cited = set(re.findall(r"`([a-z_]+(?:/[A-Za-z_]+)*/(?:[A-Za-z_]+\.py)?)`", text)) | {f for f in files if f.endswith(".py")}
+    here = {p.relative_to(PACKAGE).as_posix() for p in PACKAGE.rglob("*")} | \
+        {p.relative_to(PACKAGE).as_posix() + "/" for p in PACKAGE.rglob("*") if p.is_dir()}
+    for path in sorted(cited):
+        if "NAME" not in path and not (PACKAGE.parent / path).exists() and \
+                path.rstrip("/") not in {h.rstrip("/") for h in here} and \
+                not any(h.endswith("/" + path.rstrip("/")) for h in here):
+            missing.append(path)
+    assert not missing, f"docs/architecture.md cites what the code no longer has: {missing}"
+
+
 if __name__ == "__main__":
     sys.stdout.write(mermaid(package_edges(import_graph())))
