@@ -120,24 +120,28 @@ def _info(model, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict
 
 
 def _pictures(model, notes: list[str]) -> list[dict[str, Any]]:
-    """Three sides, visual then collision geometry (render's own drawing: contacts at home in red)."""
+    """Three sides, visual then collision geometry (render's own drawing: contacts at home in red); each
+    geometry's three sides are drawn in one pybullet child."""
     import tempfile
 
-    from ar3cli.pictures.draw import draw_robot
+    from ar3cli.pictures.draw import draw_views
 
     pictures = []
     with tempfile.TemporaryDirectory(prefix="ar3cli-report-") as folder:
         for geometry in ("visual", "collision"):
-            for side, yaw, pitch in VIEWS:
-                target = Path(folder) / f"{geometry}-{side}.png"
+            views = [(Path(folder) / f"{geometry}-{side}.png", yaw, pitch) for side, yaw, pitch in VIEWS]
+            try:
+                drawn: list = draw_views(model, views, None, *PICTURE_SIZE, show_collision=geometry == "collision",
+                                         warn=notes.append)
+            except UserError as exc:
+                drawn = [exc] * len(views)
+            for (side, _yaw, _pitch), (target, _, _), result in zip(VIEWS, views, drawn):
                 entry: dict[str, Any] = {"side": side, "geometry": geometry}
-                try:
-                    drawn = draw_robot(model, target, None, *PICTURE_SIZE, yaw_deg=yaw, pitch_deg=pitch,
-                                       show_collision=geometry == "collision", warn=notes.append)
-                    entry.update(drawn.to_dict(), png=target.read_bytes())
+                if isinstance(result, UserError):
+                    entry["error"] = result.message
+                else:
+                    entry.update(result.to_dict(), png=target.read_bytes())
                     del entry["path"]
-                except UserError as exc:
-                    entry["error"] = exc.message
                 pictures.append(entry)
                 if entry.get("error") and geometry == "visual":
                     break  # the same reason for the other sides

@@ -13,7 +13,7 @@ from __future__ import annotations
 import copy
 import io
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -153,22 +153,40 @@ def _warning_lines(warnings: list[str]) -> list[str]:
                     "(--format json lists each in visuals_not_drawn)"]
 
 
+View = tuple[Path, float, float]
+"""One picture: (PNG file to write, camera yaw, camera pitch), degrees."""
+
+
 def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | None = None,
-           width: int = 800, height: int = 600, yaw_deg: float = 45.0, pitch_deg: float = -20.0,
-           show_collision: bool = False, show_contacts: bool = True,
-           warn: Callable[[str], None] | None = None) -> RenderResult:
+               width: int = 800, height: int = 600, yaw_deg: float = 45.0, pitch_deg: float = -20.0,
+               show_collision: bool = False, show_contacts: bool = True,
+               warn: Callable[[str], None] | None = None) -> RenderResult:
     """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``.
 
     ``warn`` receives one line per visual that could not be drawn (:func:`drawable_visuals`).
     """
+    result = draw_views(model, [(output, yaw_deg, pitch_deg)], configuration, width, height, show_collision,
+                        show_contacts, warn)[0]
+    if isinstance(result, UserError):
+        raise result
+    return result
+
+
+def draw_views(model: Model, views: Sequence[View], configuration: Mapping[str, float] | None = None,
+               width: int = 800, height: int = 600, show_collision: bool = False, show_contacts: bool = True,
+               warn: Callable[[str], None] | None = None) -> list[RenderResult | UserError]:
+    """Draw ``model`` once per view, all in one pybullet child (the report's three sides load the robot
+    once, not three times): per view its RenderResult, or the UserError of a picture that shows no
+    robot. What makes every view impossible (no drawable visual, a model pybullet refuses) raises."""
     from PIL import Image
 
     from ar3cli.sim.session import run_pybullet
 
     if not 16 <= width <= 4096 or not 16 <= height <= 4096:
         raise UserError(f"image size {width}x{height} is out of range (16..4096 pixels per side)")
-    if not output.parent.is_dir():
-        raise UserError(f"-o {output}: folder {output.parent} does not exist")
+    for output, _yaw, _pitch in views:
+        if not output.parent.is_dir():
+            raise UserError(f"-o {output}: folder {output.parent} does not exist")
     shown, warnings = model, []
     if not show_collision:
         shown, warnings = drawable_visuals(model)
@@ -178,21 +196,28 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
             collision = any(link.collisions for link in model.links)
             raise UserError(f"{model.path}: no visual geometry can be drawn ({len(warnings)} visual(s) left out, see the "
                             "warnings above); " + ("try --collision" if collision else "no link has <collision> either"))
-    rgb, values, contacts = run_pybullet(
-        lambda: _draw(shown, configuration or {}, width, height, yaw_deg, pitch_deg, show_collision, show_contacts),
-        model)
-    if picture_is_empty(rgb):
-        raise UserError(f"{model.path}: the picture shows no robot: {_why_nothing_shows(model, show_collision)}")
-    buffer = io.BytesIO()
-    Image.fromarray(rgb).save(buffer, format="PNG")
-    atomic_write(output, buffer.getvalue())
-    return RenderResult(output, width, height, values, contacts,
-                        [warning.removeprefix("render: warning: ") for warning in warnings])
+    cameras = [(yaw, pitch) for _output, yaw, pitch in views]
+    pictures, values, contacts = run_pybullet(
+        lambda: _draw(shown, configuration or {}, width, height, cameras, show_collision, show_contacts), model)
+    not_drawn = [warning.removeprefix("render: warning: ") for warning in warnings]
+    results: list[RenderResult | UserError] = []
+    for (output, _yaw, _pitch), rgb in zip(views, pictures):
+        if picture_is_empty(rgb):
+            results.append(UserError(f"{model.path}: the picture shows no robot: "
+                                     f"{_why_nothing_shows(model, show_collision)}"))
+            continue
+        buffer = io.BytesIO()
+        Image.fromarray(rgb).save(buffer, format="PNG")
+        atomic_write(output, buffer.getvalue())
+        results.append(RenderResult(output, width, height, values, contacts, not_drawn))
+    return results
 
 
-def _draw(model: Model, configuration: Mapping[str, float], width: int, height: int, yaw_deg: float,
-          pitch_deg: float, show_collision: bool, show_contacts: bool) -> tuple[Any, dict[str, float], list]:
-    """In pybullet: the RGB picture, the joint values drawn, and the links in contact (drawn red)."""
+def _draw(model: Model, configuration: Mapping[str, float], width: int, height: int,
+          cameras: Sequence[tuple[float, float]], show_collision: bool,
+          show_contacts: bool) -> tuple[list[Any], dict[str, float], list]:
+    """In pybullet: one RGB picture per camera (yaw, pitch), the joint values drawn, and the links in
+    contact (drawn red)."""
     from ar3cli.infra.isolation import report_stage
     from ar3cli.sim.adjacency import nonadjacent_collisions
     from ar3cli.sim.session import SELF_COLLISION_ALL_PAIRS, Session
@@ -213,7 +238,7 @@ def _draw(model: Model, configuration: Mapping[str, float], width: int, height: 
                                         physicsClientId=session.client)
         report_stage("rendering it")
         box = drawn_box(body, show_collision)
-        return _snapshot(session, box, width, height, yaw_deg, pitch_deg), values, contacts
+        return [_snapshot(session, box, width, height, yaw, pitch) for yaw, pitch in cameras], values, contacts
 
 
 def _why_nothing_shows(model: Model, show_collision: bool) -> str:
