@@ -12,7 +12,7 @@ from lxml import etree
 
 from ar3cli.collisions import srdf as srdf_files
 from ar3cli.collisions.matrix import PairResult
-from ar3cli.urdf.srdf import GENERATED_REASONS, read_srdf
+from ar3cli.urdf.srdf_read import GENERATED_REASONS, read_srdf
 from tests.conftest import ASSETS, REPO
 
 FIXTURE = REPO / "tests" / "data" / "srdf" / "ar3.srdf"

@@ -30,7 +30,7 @@ from types import SimpleNamespace
 
 from ar3cli.collisions.matrix import DISABLED, SRDF_REASONS, PairResult, disabled_pairs
 from ar3cli.errors import UserError
-from ar3cli.urdf.srdf import GENERATED_REASONS, Srdf
+from ar3cli.urdf.srdf_read import GENERATED_REASONS, Srdf
 
 __all__ = ["Comparison", "compare", "merge", "read_for_merge", "srdf_bytes"]
 
@@ -81,7 +81,7 @@ class Merged:
 def read_for_merge(path: Path) -> Srdf:
     """The existing SRDF, read and mapped by the byte-span editor before minutes of sampling: a
     broken file, or one the editor cannot map, fails now (one line naming the file)."""
-    from ar3cli.urdf.srdf import read_srdf
+    from ar3cli.urdf.srdf_read import read_srdf
 
     existing = read_srdf(path)
     try:

@@ -115,6 +115,6 @@ def srdf_disabled(srdf: Path | None, sim: bool) -> frozenset[frozenset[str]]:
         return frozenset()
     if not sim:
         raise UserError("--srdf only changes the --sim checks (P002, contact at the home pose): add --sim")
-    from ar3cli.urdf.srdf import disabled_pairs
+    from ar3cli.urdf.srdf_read import disabled_pairs
 
     return disabled_pairs(srdf)

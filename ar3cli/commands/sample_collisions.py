@@ -86,7 +86,7 @@ def sample_collisions(
     from ar3cli.collisions import srdf as srdf_files
     from ar3cli.collisions.report import matrix_report
     from ar3cli.collisions.run import sample_matrix
-    from ar3cli.urdf.srdf import read_srdf
+    from ar3cli.urdf.srdf_read import read_srdf
 
     if srdf_merge is not None and srdf is None:
         raise UserError(f"--srdf-merge {srdf_merge}: give --srdf OUT for the merged SRDF (the same path "

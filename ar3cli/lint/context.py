@@ -18,7 +18,7 @@ class Context:
     def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset()) -> None:
         self.model = model
         self.srdf_disabled = srdf_disabled
-        """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf.is_disabled`)."""
+        """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf_read.is_disabled`)."""
         self._bounds: dict[str, Box | None] = {}
         self._shape_bounds: dict[int, Box | None] = {}
         self._session: Any = None

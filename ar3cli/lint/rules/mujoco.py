@@ -100,7 +100,7 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
 def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import adjacent_pairs, rigid_groups
     from ar3cli.sim.mujoco_session import home_pose
-    from ar3cli.urdf.srdf import is_disabled
+    from ar3cli.urdf.srdf_read import is_disabled
 
     robot, _ = _compiled(ctx)
     if robot is None:

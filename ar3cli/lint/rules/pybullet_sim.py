@@ -89,7 +89,7 @@ def _stacked_boxes(tip_z: float) -> str:
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import nonadjacent_collisions, rigid_groups
-    from ar3cli.urdf.srdf import is_disabled
+    from ar3cli.urdf.srdf_read import is_disabled
 
     with _loaded(ctx, self_collision="all-pairs") as body:
         home = _home(body) if body is not None else None
