@@ -301,6 +301,8 @@ def test_settled_rule():
     assert not cm.settled(0, 0, n, t, adjacent=True, at_home=True)  # adjacent: counted for the warning
     assert not cm.settled(20, 50, n, t, adjacent=True, at_home=False)
     assert cm.settled(20, 51, n, t, adjacent=True, at_home=False)  # past the first ~5% of samples
+    assert not cm.settled(1, 1, n, 1.0, adjacent=True, at_home=False)  # at least 50 samples, whatever t
+    assert cm.settled(3, 3, 3, 1.0, adjacent=True, at_home=False)  # or all of them
     assert not cm.settled(0, 999, n, t, adjacent=False, at_home=False)  # may still be 'never'
     assert not cm.settled(1, 51, n, t, adjacent=False, at_home=False)  # free 50: could still reach 95%
     assert cm.settled(1, 52, n, t, adjacent=False, at_home=False)  # free 51: 'sometimes' whatever follows

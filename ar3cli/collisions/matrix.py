@@ -39,6 +39,9 @@ CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
 DISABLED = ("adjacent", "default", "always", "never")
 SRDF_REASONS = {"adjacent": "Adjacent", "default": "Default", "always": "Always", "never": "Never"}
 Z_95 = 1.959963984540054
+ADJACENT_MIN_SAMPLES = 50
+"""An adjacent pair is counted over at least this many samples (or all of them) before it is retired:
+with ``--always-threshold`` near 1 the first round would otherwise be a sample or two."""
 
 
 def wilson_interval(successes: int, trials: int, z: float = Z_95) -> tuple[float, float]:
@@ -117,10 +120,11 @@ def settled(collisions: int, checked: int, samples: int, always_threshold: float
       sample such pairs either).
     - Adjacent (its category fixed by the joint tree; the direct parent-child pairs are never
       tested at all): counted only until it has been checked in more than ``(1 - always_threshold)
-      x N`` samples (the first round), for an *estimate* of its fraction. That is all the
-      ``pybullet-default-self-collision`` warning uses; it says over how many samples. An adjacent
-      pair touching in every configuration (Romeo's body - hip across a geometry-less link) costs a
-      contact manifold per configuration: measured, half of Romeo's remaining time per configuration.
+      x N`` samples (the first round; at least :data:`ADJACENT_MIN_SAMPLES`), for an *estimate* of
+      its fraction. That is all the ``pybullet-default-self-collision`` warning uses; it says over
+      how many samples. An adjacent pair touching in every configuration (Romeo's body - hip across
+      a geometry-less link) costs a contact manifold per configuration: measured, half of Romeo's
+      remaining time per configuration.
     - At the ``always`` threshold already (``collisions / samples``): more collisions keep it there.
     - Free in so many samples that even colliding in every remaining one stays below the threshold,
       having collided: ``sometimes`` whatever follows (not always, not never). A pair that has not
@@ -135,7 +139,7 @@ def settled(collisions: int, checked: int, samples: int, always_threshold: float
     if samples <= 0:
         return False
     if adjacent:
-        return checked > samples * (1.0 - always_threshold)
+        return checked > samples * (1.0 - always_threshold) and checked >= min(samples, ADJACENT_MIN_SAMPLES)
     if collisions / samples >= always_threshold:
         return True
     cannot_reach = (samples - (checked - collisions)) / samples < always_threshold
