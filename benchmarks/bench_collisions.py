@@ -189,13 +189,23 @@ def verdicts(robot: Path, samples: int, document: dict) -> str:
 
     differing = [f"{key}: ar3cli {said(key)}, independent {theirs[key][0]} ({theirs[key][1]})"
                  for key in sorted(theirs) if key not in ours or ours[key]["category"] != theirs[key][0]]
-    count_differs = sum(1 for key, pair in ours.items() if pair.get("sampled", True)
-                           and key in theirs and pair["collisions"] != theirs[key][1])
+    # a pair retired once its category was decided was counted over its first `samples` configurations only
+    complete = {key: pair for key, pair in ours.items() if pair.get("sampled", True)
+                and pair.get("samples", samples) == samples}
+    count_differs = sum(1 for key, pair in complete.items() if key in theirs and pair["collisions"] != theirs[key][1])
     same = len(theirs) - len(differing)
+    VERDICTS.append((robot.name, samples, same, len(theirs)))
     return (f"**verdicts: {same} of {len(theirs)} pairs in the same category** as an independent all-pairs check "
             f"(same {samples} configurations, one getClosestPoints query each, own adjacency; "
-            f"{time.perf_counter() - start:.0f} s); sampled pairs whose count differs: {count_differs}"
-            + (f"; differing: {'; '.join(differing[:5])}" if differing else ""))
+            f"{time.perf_counter() - start:.0f} s); pairs counted over all {samples} samples whose count differs: "
+            f"{count_differs} of {len(complete)} (the other sampled pairs were retired once their category was "
+            f"decided)" + (f"; differing: {'; '.join(differing[:5])}" if differing else ""))
+
+
+VERDICTS: list[tuple[str, int, int, int]] = []
+"""(robot, samples, pairs in the same category, pairs) of every verdict check, for the summary."""
+RATIOS: list[tuple[str, int, int, float, list[float]]] = []
+"""(robot, samples, runs, median plain / ar3cli wall ratio, the per-round ratios), for the summary."""
 
 class Parsed:
     """Keeps the JSON each run of a variant printed (last line of stdout), for the notes."""
@@ -230,40 +240,71 @@ def describe(document: dict) -> str:
     """What ar3cli's JSON says it did: processes, pairs sampled, extra configurations."""
     pairs = document.get("pairs", [])
     sampled = [pair for pair in pairs if pair.get("sampled", True)]
+    retired = [pair for pair in sampled if pair.get("retired")]
     return (f"ar3cli (its JSON): {document.get('jobs', '?')} process(es), {len(sampled)} of {len(pairs)} link "
-            f"pairs sampled (the others are adjacent, not checked), plus "
+            f"pairs sampled (the others are a link and its direct parent, not checked), {len(retired)} of them "
+            f"retired before the last sample once their category was decided, plus "
             f"{document.get('limit_configurations', '?')} home/limit configurations")
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--robot", type=Path, help="URDF to sample (default: pybullet_data's franka_panda/panda.urdf)")
-    parser.add_argument("--samples", type=int, default=10_000, help="configurations per run (default 10,000)")
+    parser.add_argument("--robot", type=Path, action="append",
+                        help="URDF to sample, repeatable (default: pybullet_data's franka_panda/panda.urdf)")
+    parser.add_argument("--samples", type=int, nargs="+", default=[10_000],
+                        help="configurations per run, one or more counts (default 10,000)")
     parser.add_argument("--runs", type=int, default=5, help="timed runs of each variant (default 5)")
+    parser.add_argument("--large-runs", type=int,
+                        help="timed runs at 100,000 samples or more (default: --runs; say so when fewer)")
+    parser.add_argument("--no-tutorial", action="store_true", help="skip the (slowest) tutorial-loop variant")
+    parser.add_argument("--no-verdicts", action="store_true",
+                        help="skip the independent all-pairs check (slow: minutes for a humanoid at 10,000)")
     parser.add_argument("--scaling-samples", type=int, default=10_000,
                         help="configurations for the --jobs rows (default 10,000; the issue's claim: 100,000)")
     parser.add_argument("--no-scaling", action="store_true", help="skip the --jobs rows")
     parser.add_argument("--scaling-only", action="store_true", help="only the --jobs rows")
     args = parser.parse_args()
 
-    robot = (args.robot or _timing.pybullet_data_path() / "franka_panda" / "panda.urdf").expanduser().resolve()
-    if not robot.is_file():
-        raise SystemExit(f"{robot}: no such file")
+    robots = [robot.expanduser().resolve() for robot in args.robot or
+              [_timing.pybullet_data_path() / "franka_panda" / "panda.urdf"]]
+    for robot in robots:
+        if not robot.is_file():
+            raise SystemExit(f"{robot}: no such file")
     ar3cli = _timing.ar3cli_command()
     script = _timing.write_script("plain_self_collision.py", BASELINE)
-    print(_timing.machine_header(f"sample-collisions: {robot.name}"))
+    print(_timing.machine_header(f"sample-collisions: {', '.join(robot.name for robot in robots)}"))
     try:
-        if not args.scaling_only:
-            compare_with_plain(ar3cli, robot, script, args.samples, args.runs)
-        if not args.no_scaling:
-            scaling(ar3cli, robot, args.scaling_samples, args.runs)
+        for robot in robots:
+            if not args.scaling_only:
+                for samples in args.samples:
+                    runs = args.large_runs if samples >= 100_000 and args.large_runs else args.runs
+                    compare_with_plain(ar3cli, robot, script, samples, runs, not args.no_tutorial,
+                                       not args.no_verdicts)
+            if not args.no_scaling:
+                scaling(ar3cli, robot, args.scaling_samples, args.runs)
+        print_summary()
         print(_timing.machine_footer())
     finally:
         _timing.cleanup()
 
 
-def compare_with_plain(ar3cli: list[str], robot: Path, script: Path, samples: int, runs: int) -> None:
-    """ar3cli (text, json) vs the plain script vs the tutorial loop, one process each."""
+def print_summary() -> None:
+    """One line per robot and sample count: the plain script's wall time over ar3cli's, and the verdicts."""
+    if not RATIOS:
+        return
+    print("#### Summary: plain script wall time / ar3cli wall time (whole processes, medians)\n")
+    print("| robot | samples | runs | plain / ar3cli | per round | verdicts (same category) |")
+    print("|---|---:|---:|---:|---|---|")
+    checked = {(robot, samples): f"{same} of {total}" for robot, samples, same, total in VERDICTS}
+    for robot, samples, runs, ratio, rounds in RATIOS:
+        print(f"| {robot} | {samples} | {runs} | **{ratio:.2f}x** | {' '.join(f'{r:.2f}' for r in rounds)} | "
+              f"{checked.get((robot, samples), 'not checked')} |")
+    print()
+
+
+def compare_with_plain(ar3cli: list[str], robot: Path, script: Path, samples: int, runs: int,
+                       tutorial_loop: bool = True, check_verdicts: bool = True) -> None:
+    """ar3cli (text, json) vs the plain script (vs the tutorial loop), one process each."""
     ours, plain, tutorial = Parsed(samples), Parsed(samples), Parsed(samples)
     command = [*ar3cli, "sample-collisions", str(robot), "--samples", str(samples), "--seed", str(SEED)]
     baseline = [sys.executable, str(script), str(robot), str(samples), str(SEED)]
@@ -272,21 +313,27 @@ def compare_with_plain(ar3cli: list[str], robot: Path, script: Path, samples: in
         _timing.Variant("the same, `--format json`", [*command, "--format", "json"], check=ours),
         _timing.Variant("plain script: resetJointState + performCollisionDetection + getContactPoints",
                         [*baseline, "detect"], check=plain),
-        _timing.Variant("tutorial loop: resetJointState + stepSimulation + getContactPoints",
-                        [*baseline, "step"], check=tutorial),
     ]
+    if tutorial_loop:
+        variants.append(_timing.Variant("tutorial loop: resetJointState + stepSimulation + getContactPoints",
+                                        [*baseline, "step"], check=tutorial))
     comparison = _timing.measure(f"{robot.name}, {samples} configurations, one process each", variants, runs)
     comparison.notes += [
         note_loop("ar3cli (json)", variants[1], ours, "elapsed_s"),
         note_loop("plain script", variants[2], plain, "loop_s"),
-        note_loop("tutorial loop", variants[3], tutorial, "loop_s"),
+        *([note_loop("tutorial loop", variants[3], tutorial, "loop_s")] if tutorial_loop else []),
         describe(ours.documents[-1]),
-        verdicts(robot, samples, ours.documents[-1]),
-        f"the plain scripts load with pybullet's default self-collision (URDF_USE_SELF_COLLISION: a link "
+        verdicts(robot, samples, ours.documents[-1]) if check_verdicts else "verdicts: not checked (--no-verdicts)",
+        f"the plain script loads with pybullet's default self-collision (URDF_USE_SELF_COLLISION: a link "
         f"and its direct parent are never checked) and found {plain.documents[-1]['pairs_in_contact']} "
-        f"(plain) / {tutorial.documents[-1]['pairs_in_contact']} (tutorial) pairs in contact at least once",
+        f"pairs in contact at least once",
     ]
+    rounds = comparison.ratios(variants[2], "wall")  # plain script / ar3cli (the reference), round by round
+    ratio = statistics.median(rounds)
+    RATIOS.append((robot.name, samples, runs, ratio, rounds))
     print(_timing.table(comparison))
+    print(f"RATIO {robot.name} {samples} samples: plain script / ar3cli = {ratio:.2f}x wall "
+          f"(rounds {min(rounds):.2f}-{max(rounds):.2f}, {runs} runs)\n", flush=True)
 
 
 def scaling(ar3cli: list[str], robot: Path, samples: int, runs: int) -> None:

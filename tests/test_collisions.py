@@ -279,3 +279,66 @@ def test_pairs_joined_only_by_fixed_joints_are_settled_once(write_urdf):
     theirs = [{pair for pair, distance in distances.items() if distance < -PENETRATION_TOLERANCE} - direct
               for distances in brute_force(model, configs[:60])]
     assert ours == theirs
+
+
+def test_round_bounds_cover_the_samples_and_start_where_a_pair_can_first_be_decided():
+    from ar3cli.collisions.rounds import round_bounds
+
+    for total, threshold in [(1, 0.95), (7, 0.95), (1000, 0.95), (100_000, 0.95), (500, 0.01), (300, 1.0)]:
+        bounds = round_bounds(total, threshold)
+        assert bounds[0][0] == 0 and bounds[-1][1] == total
+        assert all(stop > start for start, stop in bounds)
+        assert all(a[1] == b[0] for a, b in zip(bounds, bounds[1:]))
+        assert bounds[0][1] > total * (1 - threshold) or bounds[0][1] == total
+    assert round_bounds(0, 0.95) == []
+    assert len(round_bounds(100_000, 0.95)) <= 10
+
+
+def test_settled_rule():
+    """A pair is retired only when the samples still to come cannot change its verdict."""
+    n, t = 1000, 0.95
+    assert cm.settled(0, 0, n, t, adjacent=False, at_home=True)  # default, whatever the samples say
+    assert not cm.settled(0, 0, n, t, adjacent=True, at_home=True)  # adjacent: counted for the warning
+    assert not cm.settled(20, 50, n, t, adjacent=True, at_home=False)
+    assert cm.settled(20, 51, n, t, adjacent=True, at_home=False)  # past the first ~5% of samples
+    assert not cm.settled(1, 1, n, 1.0, adjacent=True, at_home=False)  # at least 50 samples, whatever t
+    assert cm.settled(3, 3, 3, 1.0, adjacent=True, at_home=False)  # or all of them
+    assert not cm.settled(0, 999, n, t, adjacent=False, at_home=False)  # may still be 'never'
+    assert not cm.settled(1, 51, n, t, adjacent=False, at_home=False)  # free 50: could still reach 95%
+    assert cm.settled(1, 52, n, t, adjacent=False, at_home=False)  # free 51: 'sometimes' whatever follows
+    assert cm.settled(950, 950, n, t, adjacent=False, at_home=False)  # 'always' already
+
+
+def test_retiring_decided_pairs_keeps_every_category(pybullet_data_dir):
+    """Counting in rounds (decided pairs filtered out) against counting every pair in every sample: the
+    same categories, the same counts for the pairs counted to the end, for any number of jobs."""
+    from ar3cli.collisions.rounds import count_in_rounds
+
+    path = pybullet_data_dir / "franka_panda" / "panda.urdf"
+    samples, threshold = 600, 0.95
+    model = load_model(path)
+    with Checker(model) as checker:
+        space = checker.joint_space()
+        home = set(checker.colliding(space.home))
+        links, pairs = checker.links, checker.pairs
+        adjacent = adjacent_pairs(model, links)
+        adjacent_ids = {k for k, (i, j) in enumerate(pairs) if frozenset((links[i], links[j])) in adjacent}
+        configs = sample_configurations(space, samples, seed=4)
+        full = count_collisions(checker, configs, jobs=1)
+
+        def settled(pair_id, collisions, checked):
+            return cm.settled(collisions, checked, samples, threshold, pair_id in adjacent_ids, pair_id in home)
+
+        counts, checked, _ = count_in_rounds(checker, configs, settled, threshold, jobs=1)
+    with Checker(model) as checker:
+        again = count_in_rounds(checker, configs, settled, threshold, jobs=2)
+    assert np.array_equal(counts, again[0]) and np.array_equal(checked, again[1])
+    assert (checked < samples).sum() > 10  # most 'sometimes' pairs, the default and adjacent ones retired
+    whole = cm.classify(links, pairs, full, samples, adjacent, home, {}, threshold, checker.unsampled)
+    rounds = cm.classify(links, pairs, counts, samples, adjacent, home, {}, threshold, checker.unsampled, checked)
+    assert [r.category for r in whole] == [r.category for r in rounds]
+    for pair_id, result in enumerate(rounds):
+        if result.sampled and not result.retired:
+            assert counts[pair_id] == full[pair_id]
+        elif result.retired:
+            assert result.samples == checked[pair_id] < samples and result.to_dict()["retired"]

@@ -42,7 +42,7 @@ from __future__ import annotations
 import gc
 import math
 import os
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
@@ -51,7 +51,7 @@ from ar3cli.sim.sampling import JointSpace, joint_space
 from ar3cli.sim.session import PENETRATION_TOLERANCE, SELF_COLLISION_DEFAULT
 from ar3cli.urdf.model import Model
 
-__all__ = ["Checker", "count_collisions"]
+__all__ = ["Checker", "count_collisions", "default_workers"]
 
 CONTACT_BREAKING_THRESHOLD = 1e-5
 """m: Bullet drops manifold points that drifted more than this; small, so teleports leave no stale points."""
@@ -112,6 +112,22 @@ class Checker:
             p.setCollisionFilterPair(body, body, self.body.link_index[self.links[i]],
                                      self.body.link_index[self.links[j]], 0, physicsClientId=client)
         return hits & self.constant
+
+    def retire(self, pair_ids: Iterable[int]) -> None:
+        """Stop pybullet testing these pairs (``setCollisionFilterPair``): their category is decided.
+
+        A retired pair costs no narrowphase work in the configurations that follow; its count then
+        stays where it was (:func:`ar3cli.collisions.rounds.count_in_rounds` stops adding to it).
+        Pairs pybullet does not test anyway (:attr:`unsampled`, :attr:`constant`) are skipped.
+        """
+        p, client, body = self.session.p, self.session.client, self.body.id
+        index = self.body.link_index
+        for pair_id in pair_ids:
+            if pair_id in self.unsampled or pair_id in self.constant:
+                continue
+            i, j = self.pairs[pair_id]
+            p.setCollisionFilterPair(body, body, index[self.links[i]], index[self.links[j]], 0,
+                                     physicsClientId=client)
 
     def _hits(self) -> set[int]:
         """Pair ids penetrating deeper than the tolerance at the current pose (after a fresh collision pass)."""
@@ -182,24 +198,36 @@ def chunk_bounds(total: int, jobs: int, per_job: int = 8, minimum: int = 100) ->
     return [(int(a), int(b)) for a, b in zip(edges[:-1], edges[1:]) if b > a]
 
 
-SAMPLES_PER_WORKER = 2_000
-"""Automatic --jobs adds a process per this many samples: a forked copy of the loaded checker starts
-in about a millisecond, but below a couple of thousand configurations (~0.2 s) it does not pay."""
+PAIR_SAMPLES_PER_WORKER = 100_000
+"""Automatic --jobs adds a process per this many (sampled pair x configuration) checks: a forked copy
+of the loaded checker starts in a few milliseconds, which pays from ~50 ms of work on. The panda (46
+sampled pairs) gets a second process from ~2,200 samples, as the old rule of one per 2,000 samples
+gave; a humanoid (Romeo: 885 sampled pairs, ~1 ms per configuration) from ~115 samples."""
+
+
+def default_workers(jobs: int | None, samples: int, pairs: int) -> int:
+    """Processes for ``samples`` configurations of ``pairs`` sampled pairs: ``jobs`` if given (at most
+    one per CPU and per sample), else one per :data:`PAIR_SAMPLES_PER_WORKER` checks, at most one per CPU."""
+    from ar3cli.infra.process_pool import worker_count
+
+    if samples <= 0:
+        return 1
+    return min(samples, worker_count(jobs, samples * max(1, pairs), PAIR_SAMPLES_PER_WORKER))
 
 
 def count_collisions(checker: Checker, configs: np.ndarray, jobs: int | None = None,
                      progress: Callable[[int], None] | None = None) -> np.ndarray:
     """Per-pair collision counts over ``configs`` (rows): exact and independent of ``jobs``.
 
-    ``jobs`` processes share the chunks, this one included (None: one per CPU, one per
-    :data:`SAMPLES_PER_WORKER` samples); each child is a fork of this process with the model
-    already loaded (a private copy-on-write copy of the in-process DIRECT world), so it starts in
+    ``jobs`` processes share the chunks, this one included (None: :func:`default_workers`); each
+    child is a fork of this process with the model already loaded (a private copy-on-write copy of
+    the in-process DIRECT world), so it starts in
     milliseconds. ``progress(n)`` is called as chunks finish (this process's own chunks, scaled
     by the number of processes: the others advance at the same pace).
     """
-    from ar3cli.infra.process_pool import map_in_processes, worker_count
+    from ar3cli.infra.process_pool import map_in_processes
 
-    workers = worker_count(jobs, len(configs), SAMPLES_PER_WORKER)
+    workers = default_workers(jobs, len(configs), len(checker.pairs) - len(checker.unsampled) - len(checker.constant))
     chunks = chunk_bounds(len(configs), workers)
     parent = os.getpid()
     tick = progress or (lambda done: None)

@@ -13,6 +13,10 @@ Categories, in MoveIt's order of precedence (``compute_default_collisions.cpp``)
    ``1 - 0.05 ** (1 / N)`` (about 3/N): "never seen" is not "impossible".
 5. ``sometimes``: everything else, with the fraction and a Wilson 95% interval. Kept enabled.
 
+A pair is counted only until its category is decided (:func:`settled`, :mod:`ar3cli.collisions.rounds`):
+its :attr:`PairResult.samples` may then be fewer than the run's N, and its fraction and interval are
+over those samples only (an estimate; the category is exact).
+
 The first four are the pairs MoveIt disables (``<disable_collisions reason="Adjacent|Default|
 Always|Never"/>``, written, merged and compared by :mod:`ar3cli.collisions.srdf`) and the pairs to
 pass to ``setCollisionFilterPair`` in PyBullet.
@@ -35,6 +39,9 @@ CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
 DISABLED = ("adjacent", "default", "always", "never")
 SRDF_REASONS = {"adjacent": "Adjacent", "default": "Default", "always": "Always", "never": "Never"}
 Z_95 = 1.959963984540054
+ADJACENT_MIN_SAMPLES = 50
+"""An adjacent pair is counted over at least this many samples (or all of them) before it is retired:
+with ``--always-threshold`` near 1 the first round would otherwise be a sample or two."""
 
 
 def wilson_interval(successes: int, trials: int, z: float = Z_95) -> tuple[float, float]:
@@ -67,13 +74,19 @@ class PairResult:
     category: str
     collisions: int
     samples: int
+    """Uniform samples the pair was checked in: the run's N, fewer when its category was decided
+    earlier (retired), 0 when decided before sampling (touching at home) or never checked."""
     at_home: bool
     limit_hits: list[str] = field(default_factory=list)
+    sampled: bool = True
+    """False for a link and its direct parent: adjacent, never checked by pybullet (``samples`` is 0)."""
+    total: int = 0
+    """The run's N (uniform samples drawn); ``samples`` below it: counted only until decided."""
 
     @property
-    def sampled(self) -> bool:
-        """False for a link and its direct parent: adjacent, never checked (``samples`` is 0)."""
-        return self.samples > 0
+    def retired(self) -> bool:
+        """Checked in fewer than all samples: its fraction and interval are estimates over ``samples``."""
+        return self.sampled and self.samples < self.total
 
     @property
     def fraction(self) -> float:
@@ -95,7 +108,42 @@ class PairResult:
         return {"link_a": self.link_a, "link_b": self.link_b, "category": self.category,
                 "collisions": self.collisions, "fraction": self.fraction, "upper_bound": self.upper_bound,
                 "interval_95": [low, high], "at_home": self.at_home, "limit_hits": self.limit_hits,
-                "sampled": self.sampled}
+                "sampled": self.sampled, "samples": self.samples, "retired": self.retired}
+
+
+def settled(collisions: int, checked: int, samples: int, always_threshold: float, adjacent: bool,
+            at_home: bool) -> bool:
+    """True when the ``samples - checked`` samples still to come cannot change what the report
+    concludes about a pair that collided in ``collisions`` of the ``checked`` so far.
+
+    - Not adjacent and touching at home: ``default`` whatever the samples say (MoveIt does not
+      sample such pairs either).
+    - Adjacent (its category fixed by the joint tree; the direct parent-child pairs are never
+      tested at all): counted only until it has been checked in more than ``(1 - always_threshold)
+      x N`` samples (the first round; at least :data:`ADJACENT_MIN_SAMPLES`), for an *estimate* of
+      its fraction. That is all the ``pybullet-default-self-collision`` warning uses; it says over
+      how many samples. An adjacent pair touching in every configuration (Romeo's body - hip across
+      a geometry-less link) costs a contact manifold per configuration: measured, half of Romeo's
+      remaining time per configuration.
+    - At the ``always`` threshold already (``collisions / samples``): more collisions keep it there.
+    - Free in so many samples that even colliding in every remaining one stays below the threshold,
+      having collided: ``sometimes`` whatever follows (not always, not never). A pair that has not
+      collided yet is not decided: it may be ``never`` (or touch only at a limit).
+
+    Its fraction over the ``checked`` samples is then on the same side of the threshold as over all
+    of them (free > N (1 - t) implies collisions / checked < t), so :func:`classify` gives the
+    category that counting every sample would give.
+    """
+    if at_home and not adjacent:
+        return True
+    if samples <= 0:
+        return False
+    if adjacent:
+        return checked > samples * (1.0 - always_threshold) and checked >= min(samples, ADJACENT_MIN_SAMPLES)
+    if collisions / samples >= always_threshold:
+        return True
+    cannot_reach = (samples - (checked - collisions)) / samples < always_threshold
+    return cannot_reach and collisions > 0
 
 
 def classify(
@@ -108,26 +156,30 @@ def classify(
     limit_hits: dict[int, list[str]],
     always_threshold: float = 0.95,
     unsampled: set[int] | frozenset[int] = frozenset(),
+    checked: Sequence[int] | None = None,
 ) -> list[PairResult]:
     """One :class:`PairResult` per pair, categorised adjacent > default > always > never > sometimes.
-    Pairs in ``unsampled`` (a link and its direct parent: adjacent) get ``samples`` 0."""
+    Pairs in ``unsampled`` (a link and its direct parent: adjacent) get ``samples`` 0. ``checked``:
+    the samples each pair was counted in (None: all ``samples``); the ``always`` test is over those,
+    which for a pair retired by :func:`settled` gives the category all ``samples`` would give."""
     results = []
     for pair_id, (i, j) in enumerate(pairs):
         a, b = links[i], links[j]
         collisions = int(counts[pair_id])
+        seen = 0 if pair_id in unsampled else samples if checked is None else int(checked[pair_id])
         hits = limit_hits.get(pair_id, [])
         if frozenset((a, b)) in adjacent:
             category = "adjacent"
         elif pair_id in home_hits:
             category = "default"
-        elif samples and collisions / samples >= always_threshold:
+        elif seen and collisions / seen >= always_threshold:
             category = "always"
         elif collisions == 0 and not hits:
             category = "never"
         else:
             category = "sometimes"
-        results.append(PairResult(a, b, category, collisions, 0 if pair_id in unsampled else samples,
-                                  pair_id in home_hits, hits))
+        results.append(PairResult(a, b, category, collisions, seen, pair_id in home_hits, hits,
+                                  sampled=pair_id not in unsampled, total=samples))
     return results
 
 
@@ -163,16 +215,21 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
                                       "PyBullet's URDF_USE_SELF_COLLISION would report this contact too"))
         elif key not in adjacent_direct and result.fraction >= always_threshold:
             found.append(Finding("pybullet-default-self-collision", Severity.WARNING,
-                                 f"{label} are in contact in {result.fraction:.0%} of samples and PyBullet's "
+                                 f"{label} are in contact in {result.fraction:.0%} of {_samples(result)} and PyBullet's "
                                  "URDF_USE_SELF_COLLISION checks them (it skips only direct parent-child pairs)",
                                  path, hint="disable the pair with setCollisionFilterPair (see --pybullet-filter)"))
-        if result.collisions == 0 and result.limit_hits:
+        if result.category == "sometimes" and result.collisions == 0 and result.limit_hits:
             found.append(Finding("contact-only-at-limits", Severity.INFO,
                                  f"{label} never collided in {result.samples} uniform samples but collide in the "
                                  f"limit configuration(s) {'; '.join(result.limit_hits)}; kept enabled (MoveIt "
                                  "would disable the pair)",
                                  path))
     return found
+
+
+def _samples(result: PairResult) -> str:
+    """``samples`` or ``the first 501 samples`` (a pair counted only until its category was decided)."""
+    return "samples" if result.samples >= result.total else f"the first {result.samples} samples"
 
 
 # ---- export -------------------------------------------------------------------------------------

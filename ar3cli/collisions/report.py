@@ -37,21 +37,25 @@ def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str,
     if OutputFormat(fmt) is OutputFormat.json:
         return Report(data=data)
     title = f"self-collision pairs of {model.path.name} ({run.samples} samples, seed {run.seed})"
-    columns = ["link a", "link b", "category", "collisions", "fraction", "95% interval", "at home", "limit hits"]
+    columns = ["link a", "link b", "category", "collisions", "samples", "fraction", "95% interval", "at home",
+               "limit hits"]
     rows = [_row(result) for result in _ordered(run.results)]
-    caption = "a link and its direct parent are adjacent and not sampled (-)"
+    caption = ("a link and its direct parent are adjacent and not sampled (-); a pair is counted only until its "
+               "category is decided (samples: how many it was checked in; 0 for a pair touching at home), its "
+               "fraction and interval are then estimates over those samples")
     if comparison is not None:
         columns.append("srdf")
         rows = [[*row, comparison.marks.get(frozenset(row[:2]), "")] for row in rows]
         caption += f"; srdf: why {comparison.path.name} disables the pair (empty: MoveIt checks it)"
     table = Table(title=title, columns=columns, rows=rows, caption=caption,
-                  numeric_columns=("collisions", "fraction", "limit hits"))
+                  numeric_columns=("collisions", "samples", "fraction", "limit hits"))
     summary = ", ".join(f"{counts[c]} {c}" for c in cm.CATEGORIES)
     rate = run.configs_per_second
     lines = [
         f"seed {run.seed}: {run.samples} uniform samples + {run.limit_configurations} home/limit configurations, "
         f"{len(run.pairs)} pairs of {len(run.links)} links with collision geometry, {run.dof} joints",
         f"{summary}; {_count(sum(counts[c] for c in cm.DISABLED), 'pair')} to disable",
+        _retired_line(run.results, run.samples),
         f"'never' means: collision probability below {never_bound:.2g} with 95% confidence (exact bound, "
         f"~3/N); more samples tighten it",
         f"{rate:,.0f} configurations/s with {_count(run.jobs, 'job')}" if rate else "",
@@ -85,8 +89,8 @@ def compare_table(comparison: Comparison, samples: int) -> Table:
         if found is None:
             rows.append([row.status, row.link_a, row.link_b, row.srdf, "", "", "", "", row.line or ""])
             continue
-        collisions = found.collisions if found.sampled else "-"
-        fraction = f"{found.fraction:.4f}" if found.sampled else "-"
+        collisions = found.collisions if found.sampled and found.samples else "-"
+        fraction = f"{found.fraction:.4f}" if found.sampled and found.samples else "-"
         rows.append([row.status, row.link_a, row.link_b, row.srdf, found.category, collisions, fraction,
                      len(found.limit_hits) or "", row.line or ""])
     caption = "; ".join(f"{status}: {meaning}" for status, meaning in COMPARE_MEANING.items())
@@ -114,12 +118,25 @@ def _ordered(results: list[cm.PairResult]) -> list[cm.PairResult]:
 
 
 def _row(result: cm.PairResult) -> list:
+    home = "yes" if result.at_home else ""
     if not result.sampled:
-        return [result.link_a, result.link_b, result.category, "-", "-", "-", "yes" if result.at_home else "", ""]
+        return [result.link_a, result.link_b, result.category, "-", "-", "-", "-", home, ""]
+    if not result.samples:  # decided before sampling (touching at home)
+        return [result.link_a, result.link_b, result.category, "", 0, "", "", home, len(result.limit_hits) or ""]
     low, high = result.interval
-    return [result.link_a, result.link_b, result.category, result.collisions, f"{result.fraction:.4f}",
-            f"{low:.4f}-{high:.4f}" if result.collisions else f"<= {result.upper_bound:.2g}",
-            "yes" if result.at_home else "", len(result.limit_hits) or ""]
+    return [result.link_a, result.link_b, result.category, result.collisions, result.samples,
+            f"{result.fraction:.4f}", f"{low:.4f}-{high:.4f}" if result.collisions else f"<= {result.upper_bound:.2g}",
+            home, len(result.limit_hits) or ""]
+
+
+def _retired_line(results: list[cm.PairResult], samples: int) -> str:
+    """How many pairs were counted only until their category was decided, and what that means."""
+    retired = [result for result in results if result.retired]
+    if not retired:
+        return ""
+    return (f"{_count(len(retired), 'pair')} counted only until the category was decided (then filtered out "
+            f"with setCollisionFilterPair): the categories are exact, the fractions and intervals of those pairs "
+            f"are estimates over the samples each was checked in (column samples, of {samples})")
 
 
 def _count(number: int, noun: str) -> str:

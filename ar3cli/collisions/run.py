@@ -44,6 +44,7 @@ class _Counted:
     pairs: list[tuple[int, int]]
     unsampled: set[int]
     counts: np.ndarray
+    checked: np.ndarray
     home_hits: set[int]
     limit_hits: dict[int, list[str]]
     limit_configurations: int
@@ -60,10 +61,10 @@ def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, alway
 
     if len(collision_links(model)) < 2:
         raise UserError(no_pairs_message(model))
-    counted = run_pybullet(lambda: _count(model, samples, seed, jobs), model)
+    counted = run_pybullet(lambda: _count(model, samples, seed, jobs, always_threshold), model)
     adjacent = adjacent_pairs(model, counted.links)
     results = cm.classify(counted.links, counted.pairs, counted.counts, samples, adjacent, counted.home_hits,
-                          counted.limit_hits, always_threshold, counted.unsampled)
+                          counted.limit_hits, always_threshold, counted.unsampled, counted.checked)
     return MatrixRun(links=counted.links, pairs=counted.pairs, results=results,
                      warnings=cm.findings(model, results, counted.links, always_threshold), samples=samples,
                      seed=seed, jobs=counted.jobs, limit_configurations=counted.limit_configurations,
@@ -71,11 +72,13 @@ def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, alway
                      unsampled=counted.unsampled)
 
 
-def _count(model: Model, samples: int, seed: int, jobs: int | None) -> _Counted:
-    """In the pybullet child: home and limit configurations, then the uniform samples, timed."""
-    from ar3cli.collisions.checker import SAMPLES_PER_WORKER, Checker, count_collisions
-    from ar3cli.infra.process_pool import worker_count
+def _count(model: Model, samples: int, seed: int, jobs: int | None, always_threshold: float) -> _Counted:
+    """In the pybullet child: home and limit configurations, then the uniform samples, timed; a pair
+    stops being counted once its category is decided (:mod:`ar3cli.collisions.rounds`)."""
+    from ar3cli.collisions.checker import Checker
+    from ar3cli.collisions.rounds import count_in_rounds
     from ar3cli.output.progress import progress_bar
+    from ar3cli.sim.adjacency import adjacent_pairs
     from ar3cli.sim.sampling import limit_configurations, sample_configurations
 
     with Checker(model) as checker:
@@ -89,13 +92,22 @@ def _count(model: Model, samples: int, seed: int, jobs: int | None) -> _Counted:
                     home_hits.add(pair_id)
                 else:
                     limit_hits.setdefault(pair_id, []).append(label)
+        adjacent = adjacent_pairs(model, checker.links)
+        adjacent_ids = {pair_id for pair_id, (i, j) in enumerate(checker.pairs)
+                        if frozenset((checker.links[i], checker.links[j])) in adjacent}
+
+        def settled(pair_id: int, collisions: int, checked: int) -> bool:
+            return cm.settled(collisions, checked, samples, always_threshold, pair_id in adjacent_ids,
+                              pair_id in home_hits)
+
         configs = sample_configurations(space, samples, seed)
         with progress_bar("sampling", samples) as advance:
             start = time.perf_counter()
-            counts = count_collisions(checker, configs, jobs, progress=advance)
+            counts, checked, workers = count_in_rounds(checker, configs, settled, always_threshold, jobs,
+                                                       progress=advance)
             elapsed = time.perf_counter() - start
-        return _Counted(checker.links, checker.pairs, checker.unsampled, counts, home_hits, limit_hits, len(limits),
-                        space.dof, elapsed, worker_count(jobs, samples, SAMPLES_PER_WORKER))
+        return _Counted(checker.links, checker.pairs, checker.unsampled, counts, checked, home_hits, limit_hits,
+                        len(limits), space.dof, elapsed, workers)
 
 
 def no_pairs_message(model: Model) -> str:
