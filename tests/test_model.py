@@ -275,3 +275,21 @@ def test_joint_type_sets_are_defined_once(write_urdf):
     text = ARM.replace('name="spin" type="continuous"', 'name="spin" type="spherical"')
     model = load_model(write_urdf(text))
     assert model.joint("spin").moves and model.joint("spin") in model.movable_joints()
+
+
+def test_pybullet_search_climbs_every_folder_and_reads_empty_package_names(tmp_path):
+    """PyBullet 3.2.7 finds ``pkg/m.obj``, ``package://pkg/m.obj`` and ``package:///pkg/m.obj`` from a URDF
+    20 folders below ``pkg``'s folder (measured). ar3cli searched 3 folders and refused ``package:///``,
+    so Talos (example-robot-data's talos_full_v2, 93 such meshes) "could not be loaded" by pybullet,
+    which loads it."""
+    mesh = tmp_path / "pkg" / "m.obj"
+    mesh.parent.mkdir()
+    mesh.write_text("v 0 0 0\n")
+    deep = tmp_path.joinpath(*[f"a{i}" for i in range(6)])
+    deep.mkdir(parents=True)
+    resolver = PackageResolver(deep)
+    for uri in ("pkg/m.obj", "package://pkg/m.obj", "package:///pkg/m.obj"):
+        found = resolver.resolve(uri)
+        assert found.path == mesh and found.via == "pybullet-search", uri
+    missing = resolver.resolve("package:///pkg/gone.obj")
+    assert not missing.found and missing.problem == "empty package name in package:/// URI"

@@ -82,8 +82,10 @@ def _package_xml_name(folder: Path, _state: PathState | None = None) -> str | No
     return match.group(1).decode("utf-8", "replace") if match else None
 
 
-PYBULLET_SEARCH_LEVELS = 3
-"""How many folders above the robot file PyBullet's fallback search climbs (measured: differential/)."""
+PYBULLET_SEARCH_LEVELS = 64
+"""How many folders above the robot file PyBullet's fallback search climbs: all of them (pybullet 3.2.7
+found ``pkg/meshes/m.obj``, ``package://pkg/meshes/m.obj`` and ``package:///pkg/meshes/m.obj`` from a
+URDF 20 folders below ``pkg``'s folder); the bound only keeps a pathological path finite."""
 
 
 class PackageResolver:
@@ -162,8 +164,8 @@ class PackageResolver:
         uri = uri.strip()
         if uri.startswith("package://"):
             name, _, rest = uri[len("package://"):].partition("/")
-            if not name:
-                return Resolution(uri, None, (), "empty package name in package:/// URI")
+            if not name:  # G002 reports it for ROS; PyBullet drops the slashes and searches (Talos' meshes)
+                return self._pybullet_search(uri, unquote(rest), (), "empty package name in package:/// URI")
             folder, tried = self.find_package(name)
             if folder is not None:
                 candidate = folder / unquote(rest)

@@ -179,14 +179,15 @@ def no_collision(ctx) -> Iterator[Hit]:
 
 @rule("G009", "pybullet-only-path", "info", "Mesh found only by PyBullet's fallback search",
       why="""The mesh resolves only because PyBullet also looks for package://NAME/x relative to the
-      URDF and a few folders above it. ROS (RViz, MoveIt, Gazebo) resolves package://NAME through
+      URDF and in every folder above it. ROS (RViz, MoveIt, Gazebo) resolves package://NAME through
       the package index and will not find it.""",
       fix="Use a path relative to the URDF, or make NAME a real package (a package.xml) or pass --package-path.",
       bad=_mesh_robot("package://meshes/base.stl"), good=_mesh_robot("meshes/base.stl"))
 def pybullet_only_path(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
-        if resolution is not None and resolution.found and resolution.via == "pybullet-search":
+        if resolution is not None and resolution.found and resolution.via == "pybullet-search" and \
+                not geometry.filename.strip().startswith("package:///"):  # G002's (an error already)
             yield Hit(f"link '{link.name}' mesh {resolution.uri} is found only by PyBullet's fallback search; "
                       "ROS tools will not find it", geometry.element)
 
