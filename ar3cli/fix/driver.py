@@ -176,7 +176,7 @@ def number(value: float) -> str:
 
 
 def refuse_xacro(paths: list[Path]) -> None:
-    from ar3cli.urdf.xacro_expand import is_xacro
+    from ar3cli.urdf.file_kind import is_xacro
 
     for path in paths:
         if is_xacro(path):

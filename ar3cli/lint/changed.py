@@ -150,8 +150,9 @@ def _used_files(path: Path, package_paths: Mapping[str, Path] | None,
                 xacro_args: Mapping[str, str] | None) -> set[str]:
     """Real paths of the files the robot file uses: its meshes (where found, or every place tried
     when missing) and, for xacro, every file xacro read. Empty when it cannot be loaded."""
+    from ar3cli.urdf.file_kind import is_xacro
     from ar3cli.urdf.model import load_model
-    from ar3cli.urdf.xacro_expand import included_files, is_xacro, origins
+    from ar3cli.urdf.xacro_expand import included_files, origins
 
     try:
         model = load_model(path, package_paths, xacro_args)

@@ -196,8 +196,8 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     ``cache`` (a :class:`~ar3cli.lint.result_cache.ResultCache`) answers for unchanged ``.urdf`` files
     and learns the findings of the others.
     """
+    from ar3cli.urdf.file_kind import is_xacro
     from ar3cli.urdf.model import load_model
-    from ar3cli.urdf.xacro_expand import is_xacro
 
     shown = display_path(path)
     if cache is not None and not is_xacro(path):

@@ -20,7 +20,8 @@ from typing import Any
 from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import read_bytes
 from ar3cli.maths.tensor_math import matrix_to_rpy, quaternion_to_matrix, rpy_to_matrix, unit_quaternion
-from ar3cli.urdf import xacro_expand, xmlsource
+from ar3cli.urdf import xmlsource
+from ar3cli.urdf.file_kind import is_xacro
 from ar3cli.urdf.packages import PackageResolver, Resolution
 from ar3cli.urdf.xmlsource import Quirk
 
@@ -360,9 +361,11 @@ def load_model(
     resolver = PackageResolver(path.parent, package_paths)
     xmlsource.refuse_entities(source, path)
     quirks: list[Quirk] = []
-    if xacro_expand.is_xacro(path):
+    if is_xacro(path):
+        from ar3cli.urdf.xacro_expand import expand
+
         _, quirks = xmlsource.normalize(source)
-        xml_bytes = xacro_expand.expand(path, dict(xacro_args or {}), resolver)
+        xml_bytes = expand(path, dict(xacro_args or {}), resolver)
         xmlsource.refuse_entities(xml_bytes, path)  # an included file may declare some
     else:
         xml_bytes, quirks = xmlsource.normalize(source)
@@ -372,7 +375,7 @@ def load_model(
         raise UserError(f"{path}:{root.sourceline or 1}: root element is <{root.tag}>, expected <robot>; "
                         "is this a URDF file?")
     return Model(path=path, root=root, source_bytes=source, xml_bytes=xml_bytes,
-                 is_xacro=xacro_expand.is_xacro(path), resolver=resolver, quirks=quirks,
+                 is_xacro=is_xacro(path), resolver=resolver, quirks=quirks,
                  links=[_read_link(element, resolver) for element in root.findall("link")],
                  joints=[_read_joint(element) for element in root.findall("joint")])
 

@@ -33,11 +33,6 @@ from ar3cli.urdf.packages import PackageResolver
 from ar3cli.urdf.xacro_safe import ReadRoots, XacroPolicy, read_inside, safe_hooks
 
 
-def is_xacro(path: Path) -> bool:
-    """True for ``robot.xacro`` and ``robot.urdf.xacro``."""
-    return path.suffix.lower() == ".xacro"
-
-
 def parse_xacro_args(items: list[str] | None) -> dict[str, str]:
     """Turn repeated ``NAME:=VALUE`` options into a mapping; raises ValueError when malformed."""
     mapping: dict[str, str] = {}
