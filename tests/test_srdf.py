@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from lxml import etree
 
-from ar3cli.collisions import srdf as srdf_files
+from ar3cli.collisions import srdf_files
 from ar3cli.collisions.matrix import PairResult
 from ar3cli.urdf.srdf_read import GENERATED_REASONS, read_srdf
 from tests.conftest import ASSETS, REPO

@@ -18,7 +18,7 @@ its :attr:`PairResult.samples` may then be fewer than the run's N, and its fract
 over those samples only (an estimate; the category is exact).
 
 The first four are the pairs MoveIt disables (``<disable_collisions reason="Adjacent|Default|
-Always|Never"/>``, written, merged and compared by :mod:`ar3cli.collisions.srdf`) and the pairs to
+Always|Never"/>``, written, merged and compared by :mod:`ar3cli.collisions.srdf_files`) and the pairs to
 pass to ``setCollisionFilterPair`` in PyBullet.
 """
 

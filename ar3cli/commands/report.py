@@ -163,7 +163,7 @@ def _cross_check(model, path: Path, samples: int, seed: int) -> tuple[dict | Non
 
 def _collisions(model, samples: int, seed: int) -> tuple[dict, list[str]]:
     """``sample-collisions --samples N --seed S --format json``'s document and summary lines."""
-    from ar3cli.collisions.report import matrix_report
+    from ar3cli.collisions.matrix_report import matrix_report
     from ar3cli.collisions.run import sample_matrix
 
     made = matrix_report(model, sample_matrix(model, samples, seed, None, 0.95), "text")

@@ -83,8 +83,8 @@ def sample_collisions(
     its direct parent are adjacent and not sampled. Exit 0 when the matrix was computed.
     """
     from ar3cli.collisions import matrix as cm
-    from ar3cli.collisions import srdf as srdf_files
-    from ar3cli.collisions.report import matrix_report
+    from ar3cli.collisions import srdf_files
+    from ar3cli.collisions.matrix_report import matrix_report
     from ar3cli.collisions.run import sample_matrix
     from ar3cli.urdf.srdf_read import read_srdf
 

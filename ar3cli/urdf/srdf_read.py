@@ -1,7 +1,7 @@
 """Reading a MoveIt SRDF: its ``<disable_collisions>``/``<enable_collisions>`` entries and
 ``<disable_default_collisions>``, safely (no entities, no DTD, no network), with one-line errors.
 
-Used by ``sample-collisions --srdf-merge/--srdf-compare`` (``ar3cli.collisions.srdf``) and by
+Used by ``sample-collisions --srdf-merge/--srdf-compare`` (``ar3cli.collisions.srdf_files``) and by
 ``lint-urdf --sim --srdf`` (pairs the user disabled are not reported as colliding at home).
 """
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from ar3cli.collisions import matrix as cm
 from ar3cli.collisions.run import MatrixRun
-from ar3cli.collisions.srdf import STATUSES, Comparison, Merged
+from ar3cli.collisions.srdf_files import STATUSES, Comparison, Merged
 from ar3cli.output.report import OutputFormat, Report, Table
 from ar3cli.urdf.model import Model
 
