@@ -6,14 +6,12 @@ import typer
 
 from ar3cli.commands.options import (
     FormatOption,
-    PackagePathOption,
     RobotPathArgument,
     SeedOption,
-    XacroArgOption,
     samples_option,
 )
+from ar3cli.commands.robot_options import RobotSource, robot_input
 from ar3cli.output.formats import finish
-from ar3cli.urdf.loading import load_with_specs
 
 SamplesOption = Annotated[int, samples_option("Random configurations compared after the home pose.", most=10_000)]
 StabilityOption = Annotated[bool, typer.Option("--stability", help="Also drop the robot passively for 1 s in both "
@@ -21,15 +19,15 @@ StabilityOption = Annotated[bool, typer.Option("--stability", help="Also drop th
 TopOption = Annotated[int, typer.Option("--top", min=1, max=1000, help="Rows of the table (largest differences first).")]
 
 
+@robot_input
 def cross_check(
     path: RobotPathArgument,
+    source: RobotSource,
     samples: SamplesOption = 20,
     seed: SeedOption = 0,
     stability: StabilityOption = False,
     top: TopOption = 10,
     format: FormatOption = "text",
-    package_path: PackagePathOption = None,
-    xacro_arg: XacroArgOption = None,
 ) -> None:
     """Check that PyBullet and MuJoCo simulate the same robot from this file.
 
@@ -43,5 +41,5 @@ def cross_check(
     from ar3cli.sim.mujoco_session import import_mujoco
 
     import_mujoco()
-    model = load_with_specs(path, package_path, xacro_arg)
+    model = source.load(path)
     finish(run(model, path, samples, seed, stability, top, announce=format == "text"), format)

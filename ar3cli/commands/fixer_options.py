@@ -17,7 +17,13 @@ from typing import TYPE_CHECKING, Annotated, Any, NoReturn, Optional
 
 import typer
 
-from ar3cli.commands.options import FollowSymlinksOption, FormatOption, PackagePathOption, TimeoutOption
+from ar3cli.commands.options import (
+    FollowSymlinksOption,
+    FormatOption,
+    PackagePathOption,
+    TimeoutOption,
+    keyword_parameter,
+)
 
 if TYPE_CHECKING:
     from ar3cli.fix.driver import Fixer, FixerArgs
@@ -31,17 +37,13 @@ OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_def
                                                            "(one input only).")]
 
 
-def _parameter(name: str, annotation: Any, default: Any = inspect.Parameter.empty) -> inspect.Parameter:
-    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
-
-
 ARGS = "args"
 """The parameter of a fixer command that receives the shared options as a ``FixerArgs``."""
-PATHS = _parameter("paths", FixPathsArgument)
-SHARED = (_parameter("diff", DiffOption, False), _parameter("check", CheckOption, False),
-          _parameter("output", OutputOption, None), _parameter("follow_symlinks", FollowSymlinksOption, False),
-          _parameter("package_path", PackagePathOption, None),
-          _parameter("format", FormatOption, "text"))
+PATHS = keyword_parameter("paths", FixPathsArgument)
+SHARED = (keyword_parameter("diff", DiffOption, False), keyword_parameter("check", CheckOption, False),
+          keyword_parameter("output", OutputOption, None), keyword_parameter("follow_symlinks", FollowSymlinksOption, False),
+          keyword_parameter("package_path", PackagePathOption, None),
+          keyword_parameter("format", FormatOption, "text"))
 """After the command's own options, in this order (``--help`` lists them so)."""
 
 
@@ -53,7 +55,7 @@ def fixer_command(timeout: float | None) -> Callable[[Callable[..., None]], Call
     def decorate(function: Callable[..., None]) -> Callable[..., None]:
         own = [parameter.replace(kind=inspect.Parameter.KEYWORD_ONLY)
                for name, parameter in inspect.signature(function).parameters.items() if name != ARGS]
-        tail = [] if timeout is None else [_parameter("timeout", TimeoutOption, timeout)]
+        tail = [] if timeout is None else [keyword_parameter("timeout", TimeoutOption, timeout)]
         parameters = [PATHS, *own, *SHARED, *tail]
 
         @functools.wraps(function)

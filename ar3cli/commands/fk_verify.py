@@ -7,21 +7,16 @@ import typer
 
 from ar3cli.commands.options import (
     FormatOption,
-    PackagePathOption,
     RobotPathArgument,
     SeedOption,
     TimeoutOption,
-    XacroArgOption,
-    XacroEnvOption,
-    XacroMode,
-    XacroModeOption,
     finite_float,
     samples_option,
 )
+from ar3cli.commands.robot_options import RobotSource, robot_input
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import finish
-from ar3cli.urdf.loading import load_with_specs
 
 SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
@@ -36,18 +31,16 @@ ToleranceRadOption = Annotated[float, typer.Option("--tolerance-rad", click_type
                                                    help="Largest orientation error that passes (rad, geodesic).")]
 
 
+@robot_input
 def fk_verify(
     path: RobotPathArgument,
+    source: RobotSource,
     samples: SamplesOption = 1000,
     seed: SeedOption = 0,
     dh: DhOption = None,
     tolerance_m: ToleranceMOption = None,
     tolerance_rad: ToleranceRadOption = 1e-6,
     format: FormatOption = "text",
-    package_path: PackagePathOption = None,
-    xacro_arg: XacroArgOption = None,
-    xacro: XacroModeOption = XacroMode.safe,
-    xacro_env: XacroEnvOption = None,
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Check that PyBullet (and your DH table) put every link frame where the URDF says.
@@ -64,7 +57,7 @@ def fk_verify(
         raise UserError("--tolerance-m and --tolerance-rad must be positive")
     tolerance = (Tolerance(DEFAULT_TOLERANCE_M, tolerance_rad, scaled=True) if tolerance_m is None
                  else Tolerance(tolerance_m, tolerance_rad))
-    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
+    model = source.load(path)
     table = dh_module.load_dh(dh, model) if dh is not None else None
     drawn, comparison = measure(model, samples, seed, announce=format == "text")
     checked = check_dh(table, dh, drawn, comparison, tolerance) if table is not None and dh is not None else None

@@ -9,20 +9,15 @@ import typer
 from ar3cli.commands.options import (
     FollowSymlinksOption,
     FormatOption,
-    PackagePathOption,
     RobotPathArgument,
     SeedOption,
     TimeoutOption,
-    XacroArgOption,
-    XacroEnvOption,
-    XacroMode,
-    XacroModeOption,
     samples_option,
 )
+from ar3cli.commands.robot_options import RobotSource, robot_input
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import finish
-from ar3cli.urdf.loading import load_with_specs
 
 TorquesOption = Annotated[bool, typer.Option(
     "--torques", help="Check that every actuated joint can hold the robot up: the largest gravity torque it needs "
@@ -35,17 +30,15 @@ PngOption = Annotated[Optional[Path], typer.Option(
     help="Draw the kinematic tree as a picture: link boxes, joints (name and type) on the edges.")]
 
 
+@robot_input
 def info(
     path: RobotPathArgument,
+    source: RobotSource,
     torques: TorquesOption = False,
     samples: SamplesOption = 200,
     seed: SeedOption = 0,
     png: PngOption = None,
     follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    xacro_arg: XacroArgOption = None,
-    xacro: XacroModeOption = XacroMode.safe,
-    xacro_env: XacroEnvOption = None,
     format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
@@ -66,7 +59,7 @@ def info(
     def zero_frames(model):
         return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
 
-    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
+    model = source.load(path)
     summary = summarize(model, zero_frames)
     check = None
     if torques:

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import inspect
 import math
 from enum import Enum
 from pathlib import Path
@@ -11,6 +12,12 @@ from typing import Annotated, Any, Optional
 import typer
 
 from ar3cli.output.formats import REPORT, choices, help_text
+
+
+def keyword_parameter(name: str, annotation: Any, default: Any = inspect.Parameter.empty) -> inspect.Parameter:
+    """A keyword-only parameter for a signature the option decorators build (``robot_input``,
+    ``fixer_command``): typer reads the options from it."""
+    return inspect.Parameter(name, inspect.Parameter.KEYWORD_ONLY, default=default, annotation=annotation)
 
 
 def format_option(kinds: tuple[str, ...], enum_name: str) -> Any:

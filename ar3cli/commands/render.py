@@ -8,23 +8,20 @@ import typer
 from ar3cli.commands.options import (
     FollowSymlinksOption,
     FormatOption,
-    PackagePathOption,
     RobotPathArgument,
     TimeoutOption,
-    XacroArgOption,
-    XacroEnvOption,
-    XacroMode,
-    XacroModeOption,
     finite_float,
 )
+from ar3cli.commands.robot_options import RobotSource, robot_input
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import finish
 from ar3cli.output.report import Report, Table, log
-from ar3cli.urdf.loading import load_with_specs
 
 
+@robot_input
 def render_command(
     path: RobotPathArgument,
+    source: RobotSource,
     output: Annotated[Path, typer.Option("--output", "-o", help="PNG file to write.")] = Path("robot.png"),
     config: Annotated[Optional[str], typer.Option(
         "--config", metavar="JOINT=VALUE,...",
@@ -38,10 +35,6 @@ def render_command(
     pitch: Annotated[float, typer.Option(click_type=finite_float(),
                                          help="Camera pitch, degrees (negative looks down).")] = -20.0,
     follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    xacro_arg: XacroArgOption = None,
-    xacro: XacroModeOption = XacroMode.safe,
-    xacro_env: XacroEnvOption = None,
     format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
@@ -55,7 +48,7 @@ def render_command(
 
     output = check_writable(output, follow_symlinks)  # before any work; a planted link is refused
     configuration = parse_configuration(config)
-    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
+    model = source.load(path)
     result = draw_robot(model, output, configuration, width=width, height=height, yaw_deg=yaw, pitch_deg=pitch,
                   show_collision=collision, warn=log)
     tables = []

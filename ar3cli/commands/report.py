@@ -19,16 +19,12 @@ import typer
 from ar3cli.commands.options import (
     FollowSymlinksOption,
     FormatOption,
-    PackagePathOption,
     RobotPathArgument,
     SeedOption,
     TimeoutOption,
-    XacroArgOption,
-    XacroEnvOption,
-    XacroMode,
-    XacroModeOption,
     samples_option,
 )
+from ar3cli.commands.robot_options import RobotSource, robot_input
 from ar3cli.errors import UserError
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import finish
@@ -43,17 +39,15 @@ SamplesOption = Annotated[int, samples_option(
     "a page, not a study; sample-collisions defaults to 10000).", most=100_000)]
 
 
+@robot_input
 def report(
     path: RobotPathArgument,
+    source: RobotSource,
     output: Annotated[Path, typer.Option("--output", "-o", metavar="FILE.html", dir_okay=False,
                                          help="The HTML file to write.", show_default=False)],
     samples: SamplesOption = 100,
     seed: SeedOption = 0,
     follow_symlinks: FollowSymlinksOption = False,
-    package_path: PackagePathOption = None,
-    xacro_arg: XacroArgOption = None,
-    xacro: XacroModeOption = XacroMode.safe,
-    xacro_env: XacroEnvOption = None,
     format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
@@ -69,15 +63,14 @@ def report(
     from ar3cli.commands.lint_report import lint_document
     from ar3cli.infra.atomic import atomic_write, check_writable
     from ar3cli.output.html import robot_page
-    from ar3cli.urdf.loading import load_with_specs
 
     output = check_writable(output, follow_symlinks)
     data: dict[str, Any] = {"settings": {"samples": samples, "seed": seed,
                                          "described": f"{samples} samples, seed {seed}"}, "skipped": {},
                             "cross_check": None}
     lines: dict[str, list[str]] = {}
-    data["lint"], findings = lint_document(path, package_path, xacro_arg)
-    model = load_with_specs(path, package_path, xacro_arg, xacro is XacroMode.trusted, xacro_env)
+    data["lint"], findings = lint_document(path, source.package_path, source.xacro_arg)
+    model = source.load(path)
     data["info"], lines["info"], lines["torques"] = _info(model, samples, seed, data["skipped"])
     pictures = _pictures(model, lines.setdefault("pictures", []))
     data["renders"] = [{key: value for key, value in p.items() if key != "png"} for p in pictures]
