@@ -155,7 +155,7 @@ def detached_child(ctx) -> Iterator[Hit]:
         if found is None:
             continue
         gap, size, ancestor, joint = found
-        if gap > max(DETACHED_MIN_GAP, DETACHED_FACTOR * size) and not collision_off(ctx, link):
+        if gap > max(DETACHED_MIN_GAP, DETACHED_FACTOR * size) and collision_off(ctx, link) is None:
             yield Hit(f"joint '{joint.name}' origin xyz=\"{' '.join(f'{v:g}' for v in joint.origin.xyz)}\" looks "
                       f"wrong: it puts link '{link.name}' {gap:.3g} m away from link '{ancestor.name}' (parts about "
                       f"{size:.3g} m across) at the home pose",
@@ -188,15 +188,16 @@ def collision_offset(ctx, link) -> tuple[float, float, Box, Box] | None:
     return _overlap_fraction(visual, collision), math.dist(centre, other), visual, collision
 
 
-def collision_off(ctx, link) -> bool:
-    """G015's verdict for ``link``: its collision box barely covers its visual box and sits apart. G014
-    then stays quiet about the same link: the joint is not to blame when only the collision is off
-    (alex_nub_hands.urdf's nubs: ``<origin xyz="0 1.57 0">``, the rpy typed into xyz)."""
+def collision_off(ctx, link) -> tuple[float, float, Box, Box] | None:
+    """G015's verdict for ``link``: its :func:`collision_offset` when its collision box barely covers
+    its visual box and sits apart, else None. G014 then stays quiet about the same link: the joint is
+    not to blame when only the collision is off (alex_nub_hands.urdf's nubs: ``<origin xyz="0 1.57 0">``,
+    the rpy typed into xyz)."""
     found = collision_offset(ctx, link)
     if found is None:
-        return False
+        return None
     covered, offset, visual, _collision = found
-    return covered < COVER_MIN and offset > max(OFFSET_MIN, OFFSET_FACTOR * _diagonal(visual) / 2)
+    return found if covered < COVER_MIN and offset > max(OFFSET_MIN, OFFSET_FACTOR * _diagonal(visual) / 2) else None
 
 
 def _visual_and_collision(collision_xyz: str) -> str:
@@ -218,8 +219,9 @@ def _visual_and_collision(collision_xyz: str) -> str:
       references="simcheck 0.2.0 (collision-vs-visual match).")
 def collision_off_visual(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        if collision_off(ctx, link):
-            covered, offset, _visual, _collision = collision_offset(ctx, link)  # type: ignore[misc]
+        found = collision_off(ctx, link)
+        if found is not None:
+            covered, offset, _visual, _collision = found
             yield Hit(f"link '{link.name}' collision box covers {covered:.0%} of its visual box; their centres are "
                       f"{offset:.3g} m apart", link.collisions[0].element)
 
