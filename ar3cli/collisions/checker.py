@@ -98,6 +98,11 @@ class Checker:
                                    if pair_id not in self.unsampled and group[self.links[i]] == group[self.links[j]]}
         self._constant_hits = self._settle_constant_pairs()
 
+    @property
+    def sampled_pairs(self) -> int:
+        """How many pairs each configuration tests: all but :attr:`unsampled` and :attr:`constant`."""
+        return len(self.pairs) - len(self.unsampled) - len(self.constant)
+
     def _settle_constant_pairs(self) -> set[int]:
         """Test the :attr:`constant` pairs once, at the pose just loaded, then stop pybullet testing them.
 
@@ -227,7 +232,7 @@ def count_collisions(checker: Checker, configs: np.ndarray, jobs: int | None = N
     """
     from ar3cli.infra.process_pool import map_in_processes
 
-    workers = default_workers(jobs, len(configs), len(checker.pairs) - len(checker.unsampled) - len(checker.constant))
+    workers = default_workers(jobs, len(configs), checker.sampled_pairs)
     chunks = chunk_bounds(len(configs), workers)
     parent = os.getpid()
     tick = progress or (lambda done: None)

@@ -64,8 +64,7 @@ def count_in_rounds(checker: Checker, configs: np.ndarray, settled: Settled, alw
     checked = np.zeros(count, dtype=np.int64)
     active = np.ones(count, dtype=bool)
     active[list(checker.unsampled)] = False
-    tested = count - len(checker.unsampled) - len(checker.constant)
-    workers = default_workers(jobs, total, tested)
+    workers = default_workers(jobs, total, checker.sampled_pairs)
 
     def retire_settled() -> None:
         decided = [int(pair_id) for pair_id in np.flatnonzero(active)
