@@ -163,7 +163,8 @@ def draw_robot(model: Model, output: Path, configuration: Mapping[str, float] | 
                warn: Callable[[str], None] | None = None) -> RenderResult:
     """Draw ``model`` at ``configuration`` (default: home pose) into the PNG file ``output``.
 
-    ``warn`` receives one line per visual that could not be drawn (:func:`drawable_visuals`).
+    ``warn`` receives the warning lines about visuals that could not be drawn (:func:`drawable_visuals`;
+    at most :data:`WARNING_LINES`, the result's ``not_drawn`` lists each).
     """
     result = draw_views(model, [(output, yaw_deg, pitch_deg)], configuration, width, height, show_collision,
                         show_contacts, warn)[0]

@@ -125,12 +125,12 @@ def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str,
 
     def wrap(check: Check | None) -> Rule:
         return _register(Rule(code=code, name=name, severity=Severity(severity), title=title,
-                    why=" ".join(why.split()), fix=" ".join(fix.split()),
-                    bad=textwrap.dedent(bad).strip() + "\n", good=textwrap.dedent(good).strip() + "\n",
-                    check=check, needs_sim=needs_sim, fixed_by=fixed_by,
-                    thresholds=" ".join(thresholds.split()) if thresholds else None,
-                    references=" ".join(references.split()) if references else None, opt_in=opt_in,
-                    targets=targets))
+                              why=" ".join(why.split()), fix=" ".join(fix.split()),
+                              bad=textwrap.dedent(bad).strip() + "\n", good=textwrap.dedent(good).strip() + "\n",
+                              check=check, needs_sim=needs_sim, fixed_by=fixed_by,
+                              thresholds=" ".join(thresholds.split()) if thresholds else None,
+                              references=" ".join(references.split()) if references else None, opt_in=opt_in,
+                              targets=targets))
 
     return wrap
 
