@@ -42,6 +42,16 @@ def _root(
     """Diagnose, fix and sim-check robot description files (URDF and xacro) with PyBullet."""
 
 
+def _fixer_commands() -> dict[str, str]:
+    """``fix-NAME`` -> its ``FIXER`` for every ``fix/NAME_plan.py``, alphabetically: a fixer is one
+    module, found by its file name (the folder is listed, nothing imported)."""
+    folder = os.path.join(os.path.dirname(__file__), "fix")
+    plans = sorted(name[:-3] for name in os.listdir(folder) if name.endswith("_plan.py"))
+    return {"fix-" + plan.removesuffix("_plan").replace("_", "-"): f"ar3cli.fix.{plan}:{FIXER}" for plan in plans}
+
+
+FIXER = "FIXER"
+"""What a ``fix/*_plan.py`` exports; :func:`ar3cli.commands.fixer_options.fixer_command` makes it a command."""
 COMMANDS: dict[str, str] = {
     "install-check": "ar3cli.commands.install_check:install_check",
     "info": "ar3cli.commands.info:info",
@@ -49,11 +59,7 @@ COMMANDS: dict[str, str] = {
     "fk-verify": "ar3cli.commands.fk_verify:fk_verify",
     "lint-urdf": "ar3cli.commands.lint_urdf:lint_urdf",
     "grasp-demo": "ar3cli.commands.grasp_demo:grasp_demo",
-    "fix-inertia": "ar3cli.commands.fix_inertia:fix_inertia",
-    "fix-continuous": "ar3cli.commands.fix_continuous:fix_continuous",
-    "fix-joints": "ar3cli.commands.fix_joints:fix_joints",
-    "fix-mesh-paths": "ar3cli.commands.fix_mesh_paths:fix_mesh_paths",
-    "fix-collision": "ar3cli.commands.fix_collision:fix_collision",
+    **_fixer_commands(),
     "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",
     "cross-check": "ar3cli.commands.cross_check:cross_check",
     "diff": "ar3cli.commands.diff:diff",
@@ -61,8 +67,8 @@ COMMANDS: dict[str, str] = {
     "scan-report": "ar3cli.commands.scan_report:scan_report",
     "report": "ar3cli.commands.report:report",
 }
-"""Every command, in the order ``--help`` lists them, and where its function is. A run imports
-only the module of the command it runs (see :func:`application`)."""
+"""Every command, in the order ``--help`` lists them, and where its function (or its fixer) is. A
+run imports only the module of the command it runs (see :func:`application`)."""
 
 
 def application(argv: Sequence[str] | None = None) -> typer.Typer:
@@ -76,8 +82,13 @@ def application(argv: Sequence[str] | None = None) -> typer.Typer:
     registered = {info.name for info in app.registered_commands}
     for name in names:
         if name not in registered:
-            module, _, function = COMMANDS[name].partition(":")
-            app.command(name)(getattr(importlib.import_module(module), function))
+            module, _, attribute = COMMANDS[name].partition(":")
+            function = getattr(importlib.import_module(module), attribute)
+            if attribute == FIXER:
+                from ar3cli.commands.fixer_options import fixer_command
+
+                function = fixer_command(function)
+            app.command(name)(function)
     order = {name: index for index, name in enumerate(COMMANDS)}
     app.registered_commands.sort(key=lambda info: order.get(info.name or "", len(order)))
     return app

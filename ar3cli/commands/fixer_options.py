@@ -1,19 +1,22 @@
-"""The options every fixer command takes, declared once: :func:`fixer_command` adds them.
+"""Every ``fix-*`` command, built from its fixer: :func:`fixer_command`.
 
-A fixer command (``fix-*``) is a function of its own options and ``args: FixerArgs``; the
-decorator gives typer a signature with the file argument first, the command's own options, then
-``--diff``, ``--check``, ``-o``, ``--follow-symlinks``, ``--package-path``, ``--format`` and
-(for the fixers that start a child process) ``--timeout``, and hands the function those values
-as one :class:`~ar3cli.fix.driver.FixerArgs`. :func:`run_fix` runs the fixer and exits with its code.
+A fixer is one module, ``fix/NAME_plan.py``, exporting ``FIXER`` (a :class:`~ar3cli.fix.driver.Fixer`);
+there is no command module per fixer. The command's signature is the file argument first, the
+fixer's own options (declared on its options dataclass with :func:`~ar3cli.fix.settings.setting`),
+then the options every fixer takes, declared here once: ``--diff``, ``--check``, ``-o``,
+``--follow-symlinks``, ``--package-path``, ``--format`` and (for the fixers that start a child
+process) ``--timeout``. The shared values reach the fixer as one :class:`~ar3cli.fix.driver.FixerArgs`.
 """
 
 from __future__ import annotations
 
-import functools
 import inspect
+import types
+import typing
 from collections.abc import Callable
+from dataclasses import MISSING
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated, Any, NoReturn, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 
@@ -21,12 +24,15 @@ from ar3cli.commands.options import (
     FollowSymlinksOption,
     FormatOption,
     PackagePathOption,
+    SeedOption,
     TimeoutOption,
+    finite_float,
     keyword_parameter,
 )
 
 if TYPE_CHECKING:
-    from ar3cli.fix.driver import Fixer, FixerArgs
+    from ar3cli.fix.driver import Fixer
+    from ar3cli.fix.settings import SettingField
 
 FixPathsArgument = Annotated[list[Path], typer.Argument(metavar="PATH", show_default=False,
                                                         help=".urdf files to fix (xacro is refused).")]
@@ -37,8 +43,6 @@ OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_def
                                                            "(one input only).")]
 
 
-ARGS = "args"
-"""The parameter of a fixer command that receives the shared options as a ``FixerArgs``."""
 PATHS = keyword_parameter("paths", FixPathsArgument)
 SHARED = (keyword_parameter("diff", DiffOption, False), keyword_parameter("check", CheckOption, False),
           keyword_parameter("output", OutputOption, None), keyword_parameter("follow_symlinks", FollowSymlinksOption, False),
@@ -47,34 +51,57 @@ SHARED = (keyword_parameter("diff", DiffOption, False), keyword_parameter("check
 """After the command's own options, in this order (``--help`` lists them so)."""
 
 
-def fixer_command(timeout: float | None) -> Callable[[Callable[..., None]], Callable[..., None]]:
-    """Give a fixer command the shared options; ``timeout`` is its ``--timeout`` default (None: the
-    fixer starts no child process and has no ``--timeout``). The command's function takes
-    ``args: FixerArgs`` and its own options; its docstring is its help."""
-
-    def decorate(function: Callable[..., None]) -> Callable[..., None]:
-        own = [parameter.replace(kind=inspect.Parameter.KEYWORD_ONLY)
-               for name, parameter in inspect.signature(function).parameters.items() if name != ARGS]
-        tail = [] if timeout is None else [keyword_parameter("timeout", TimeoutOption, timeout)]
-        parameters = [PATHS, *own, *SHARED, *tail]
-
-        @functools.wraps(function)
-        def command(**values: Any) -> None:
-            from ar3cli.fix.driver import FixerArgs
-
-            shared = {parameter.name: values.pop(parameter.name) for parameter in (PATHS, *SHARED)}
-            values.pop("timeout", None)  # set for the child processes by the option's callback
-            function(**values, **{ARGS: FixerArgs(**shared)})
-
-        command.__signature__ = inspect.Signature(parameters, return_annotation=None)  # type: ignore[attr-defined]
-        command.__annotations__ = {parameter.name: parameter.annotation for parameter in parameters}
-        return command
-
-    return decorate
+SHARED_BY_NAME = {"seed": SeedOption}
+"""Options a fixer names without flags (``seed: int = setting(default=0)``): the same ``--seed`` as
+every sampling command."""
 
 
-def run_fix(fixer: Fixer, options: Any, args: FixerArgs, verify: bool = False) -> NoReturn:
-    """Run ``fixer`` (a ``fix/*_plan.py``'s ``FIXER``) and exit with its code."""
-    from ar3cli.fix.driver import run_fixer
+def fixer_command(fixer: Fixer) -> Callable[..., None]:
+    """The ``fix-*`` command of ``fixer`` (a ``fix/*_plan.py``'s ``FIXER``): the file argument, the
+    fixer's own options (the :func:`~ar3cli.fix.settings.setting` fields of ``fixer.options``), the
+    shared ones, and ``--timeout`` when ``fixer.timeout`` is set. It builds ``fixer.options`` from
+    its values, runs the fixer and exits with its code; ``fixer.help`` is its ``--help``."""
+    from ar3cli.fix.settings import settings_of
 
-    raise typer.Exit(run_fixer(fixer, options, args, verify=verify))
+    own = [_own_option(item) for item in settings_of(fixer.options)] if fixer.options is not None else []
+    tail = [] if fixer.timeout is None else [keyword_parameter("timeout", TimeoutOption, fixer.timeout)]
+    parameters = [PATHS, *own, *SHARED, *tail]
+
+    def command(**values: Any) -> None:
+        from ar3cli.fix.driver import FixerArgs
+
+        shared = {parameter.name: values.pop(parameter.name) for parameter in (PATHS, *SHARED)}
+        values.pop("timeout", None)  # set for the child processes by the option's callback
+        options = fixer.options(**values) if fixer.options is not None else None
+        raise typer.Exit(fixer.run(options, FixerArgs(**shared)))
+
+    command.__name__ = command.__qualname__ = fixer.name.replace("-", "_")
+    command.__doc__ = fixer.help
+    command.__signature__ = inspect.Signature(parameters, return_annotation=None)  # type: ignore[attr-defined]
+    command.__annotations__ = {parameter.name: parameter.annotation for parameter in parameters}
+    return command
+
+
+def _own_option(item: SettingField) -> inspect.Parameter:
+    """The typer option of one fixer setting: a float is finite (and within its bounds), an int within
+    its bounds; no default means required."""
+    setting = item.setting
+    default = inspect.Parameter.empty if item.default is MISSING else item.default
+    if not setting.flags:
+        return keyword_parameter(item.name, SHARED_BY_NAME[item.name], default)
+    extra: dict[str, Any] = {}
+    if float in _types(item.annotation):
+        extra["click_type"] = finite_float(setting.minimum, setting.maximum)
+    elif setting.minimum is not None or setting.maximum is not None:
+        extra.update(min=setting.minimum, max=setting.maximum)
+    if setting.metavar is not None:
+        extra["metavar"] = setting.metavar
+    if item.default is MISSING:
+        extra["show_default"] = False
+    option = typer.Option(*setting.flags, help=setting.help, **extra)
+    return keyword_parameter(item.name, Annotated[item.annotation, option], default)
+
+
+def _types(annotation: Any) -> tuple[Any, ...]:
+    """``float | None`` -> ``(float, NoneType)``; a plain type -> ``(type,)``."""
+    return typing.get_args(annotation) if isinstance(annotation, types.UnionType) else (annotation,)

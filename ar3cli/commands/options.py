@@ -92,6 +92,10 @@ class FiniteFloat(_float_range_type()):
             self.fail(f"{value}: must be a finite number", param, ctx)
         return super().convert(value, param, ctx)
 
+    def _describe_range(self) -> str:
+        """No bounds, no range in ``--help`` (click's FloatRange printed ``[x<=None]``)."""
+        return "" if self.min is None and self.max is None else super()._describe_range()
+
 
 def finite_float(min: float | None = None, max: float | None = None) -> FiniteFloat:
     """The click type of a float option: finite, and within ``min`` .. ``max`` when given. Pass it

@@ -27,11 +27,15 @@ import hashlib
 import os
 import re
 import shutil
+import tempfile
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, verified_in_pybullet
+from ar3cli.fix.driver import Change, Fixer, FixerArgs, FixPlan, Skipped, check_row, verified_in_pybullet
+from ar3cli.fix.settings import setting
+from ar3cli.infra.child_limits import LONG_TIMEOUT_S
 from ar3cli.urdf.edits import Document, Span
 
 MAX_HULL_RATIO = 2.0
@@ -49,11 +53,32 @@ _PART_FILE = re.compile(r"part_(\d+)\.obj$")
 
 @dataclass
 class CollisionOptions:
-    max_hull_ratio: float = MAX_HULL_RATIO
-    method: str = "vhacd"
-    """Resolved: ``vhacd`` or ``coacd``."""
-    resolution: int = 0
-    from_visual: bool = False
+    """fix-collision's own options (each :func:`~ar3cli.fix.settings.setting` is one), then the
+    run's state: where part files go and which were created."""
+
+    max_hull_ratio: float = setting(
+        "--max-hull-ratio", default=MAX_HULL_RATIO,
+        help="Decompose a collision mesh whose convex hull has more than this many times its volume (the mesh "
+             "must be closed).")
+    method: str = setting(
+        "--method", default="auto",
+        help="coacd, vhacd (pybullet's), or auto: coacd when installed (pip install 'ar3cli[decompose]'), "
+             "else vhacd.")
+    """After ``__post_init__``: ``vhacd`` or ``coacd``."""
+    resolution: int = setting("--resolution", default=100_000, minimum=10_000, maximum=64_000_000,
+                              help="vhacd's voxel count: higher is finer and slower.")
+    from_visual: bool = setting(
+        "--from-visual", default=False,
+        help="Links with a `<visual>` but no `<collision>` get one: a primitive copied, a mesh as its convex "
+             "hull (decomposed when its hull ratio is above the limit).")
+    verify: bool = setting(
+        "--verify/--no-verify", default=True,
+        help="Compare the original and the fixed robot in PyBullet (home contacts and sampled pair categories; "
+             "a decomposition that makes a pair collide more is refused), and after writing count each "
+             "changed link's collision shapes.")
+    samples: int = setting("--samples", "-n", default=VERIFY_SAMPLES, minimum=1, maximum=100_000,
+                           help="Configurations sampled to compare pair categories before and after the fix.")
+    seed: int = setting(default=0)
     output: Path | None = None
     write: bool = False
     """True when the URDF will be written: parts go to their final folder, else to ``staging``."""
@@ -65,10 +90,13 @@ class CollisionOptions:
     """Raw decompositions by mesh file and parameters (:func:`~ar3cli.fix.decompose.decompose`'s cache)."""
     follow_symlinks: bool = False
     """Write a symlinked URDF's target (``--follow-symlinks``); part folders never leave the URDF's folder."""
-    compare: bool = False
-    """Compare the original and the fixed robot in PyBullet before accepting a replacement."""
-    samples: int = VERIFY_SAMPLES
-    seed: int = 0
+
+    def __post_init__(self) -> None:
+        if not self.max_hull_ratio > 1.0:
+            raise UserError(f"--max-hull-ratio {self.max_hull_ratio}: must be above 1 (a convex mesh is 1)")
+        from ar3cli.fix.decompose import resolve_method  # numpy: when the command runs, not for --help
+
+        self.method = resolve_method(self.method)
 
     def rollback(self) -> None:
         """Remove the part files of every URDF that was not rewritten (the run failed before it)."""
@@ -221,7 +249,7 @@ def plan_collisions(model, document: Document, options: CollisionOptions) -> Fix
             plan.data["collisions"].append(row)
         if options.from_visual and not link.collisions and link.visuals:
             _from_visuals(document, plan, writer, link, measured, options, inserts)
-    if pending and options.compare and options.write:
+    if pending and options.verify and options.write:
         from ar3cli.fix.collision_compare import accept_replacements
 
         accepted = accept_replacements(model, target, pending, inserts, plan, options)
@@ -483,8 +511,17 @@ def _escape(value: str, quote: bytes) -> bytes:
     return text.encode("utf-8")
 
 
-def remove_staging(options: CollisionOptions) -> None:
-    if options.staging is not None:
+@contextlib.contextmanager
+def staged(options: CollisionOptions, args: FixerArgs) -> Iterator[FixerArgs]:
+    """The run of fix-collision: part files are staged in a temporary folder (``--diff``/``--check``)
+    or written beside the URDF; afterwards the part files of a URDF that was not rewritten (an error,
+    a failed check) and the staging folder are removed, whatever ended the run."""
+    options.output, options.write, options.follow_symlinks = args.output, args.writes, args.follow_symlinks
+    options.staging = Path(tempfile.mkdtemp(prefix="ar3cli-parts-"))
+    try:
+        yield args
+    finally:
+        options.rollback()
         shutil.rmtree(options.staging, ignore_errors=True)
 
 
@@ -532,6 +569,15 @@ def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[s
     return checks
 
 
-FIXER = Fixer[CollisionOptions]("fix-collision", plan_collisions, verify)
-"""What ``ar3cli fix-collision`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
-:func:`plan_collisions`, then :func:`verify` with ``--verify``."""
+FIXER = Fixer[CollisionOptions]("fix-collision", plan_collisions, verify, options=CollisionOptions,
+                                 timeout=LONG_TIMEOUT_S, session=staged, help="""\
+Replace a collision mesh that collides as a much larger convex hull by convex parts.
+
+PyBullet collides a moving link's mesh as its convex hull. Where hull volume / mesh volume is
+above --max-hull-ratio, that `<collision>` becomes one `<collision>` per part of a convex
+decomposition (CoACD or pybullet's V-HACD), written as OBJ files in
+`collision/LINK/` beside the URDF; origin, scale and formatting are kept. With --diff or
+--check nothing is written, part files included.
+""")
+"""``ar3cli fix-collision``: :func:`plan_collisions` inside :func:`staged`, then :func:`verify` with
+``--verify``."""

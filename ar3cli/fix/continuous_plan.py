@@ -19,8 +19,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
+from ar3cli.fix.settings import require_positive, setting
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.urdf.edits import Document
-from ar3cli.urdf.joint_limits_yaml import YamlLimits
+from ar3cli.urdf.joint_limits_yaml import YamlLimits, read_joint_limits
 
 FULL_TURN = 2.0 * math.pi
 FULL_TURN_TOLERANCE = 1e-6
@@ -29,12 +31,27 @@ FULL_TURN_TOLERANCE = 1e-6
 
 @dataclass
 class ContinuousOptions:
-    limits: dict[str, YamlLimits] | None = None
-    limits_path: Path | None = None
-    to_continuous: bool = False
-    effort: float | None = None
-    velocity: float | None = None
+    """fix-continuous' own options (each :func:`~ar3cli.fix.settings.setting` is one), and the limits read."""
+
+    limits_path: Path | None = setting(
+        "--limits-from", metavar="JOINT_LIMITS_YAML", default=None,
+        help="MoveIt joint_limits.yaml: joints with has_position_limits become revolute with its limits.")
+    to_continuous: bool = setting(
+        "--to-continuous", default=False,
+        help="Revolute joints whose range covers a full turn (>= 2 pi) become continuous.")
+    effort: float | None = setting("--effort", default=None,
+                                   help="Effort (N*m or N) to add where a fixed joint's `<limit>` has none.")
+    velocity: float | None = setting("--velocity", default=None,
+                                     help="Velocity (rad/s or m/s) to add where a fixed joint's `<limit>` has none.")
+    verify: bool = setting("--verify/--no-verify", default=True,
+                           help="After writing, load the result in PyBullet and check the joints.")
+    limits: dict[str, YamlLimits] | None = field(default=None, init=False)
+    """``--limits-from``'s joints, read once."""
     warnings: list[str] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        require_positive(effort=self.effort, velocity=self.velocity)
+        self.limits = read_joint_limits(self.limits_path) if self.limits_path is not None else None
 
 
 def plan_continuous(model, document: Document, options: ContinuousOptions) -> FixPlan:
@@ -231,6 +248,11 @@ def _drive(session, body, index: int, target: float, steps: int = 2400) -> float
     return float(p.getJointState(body.id, index, physicsClientId=session.client)[0])
 
 
-FIXER = Fixer[ContinuousOptions]("fix-continuous", plan_continuous, verify)
-"""What ``ar3cli fix-continuous`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
-:func:`plan_continuous`, then :func:`verify` with ``--verify``."""
+FIXER = Fixer[ContinuousOptions]("fix-continuous", plan_continuous, verify, options=ContinuousOptions,
+                                  timeout=DEFAULT_TIMEOUT_S, help="""\
+Fix continuous joints: lower/upper on a continuous joint only add a PyBullet position clamp.
+
+Default: remove them (keep effort/velocity). --limits-from turns joints with hard stops
+into revolute joints with the real limits. Edits only those joints, byte for byte, atomically.
+""")
+"""``ar3cli fix-continuous``: :func:`plan_continuous`, then :func:`verify` with ``--verify``."""

@@ -16,6 +16,7 @@ from __future__ import annotations
 import difflib
 import math
 from collections.abc import Callable
+from contextlib import AbstractContextManager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Generic, TypeVar
@@ -76,6 +77,26 @@ class Fixer(Generic[Options]):
     what was skipped; the options are the command's own (``JointsOptions``, ...)."""
     verify: Verifier | None = None
     """Checks the written file (in PyBullet); None when there is nothing a load could check."""
+    options: type[Options] | None = field(default=None, kw_only=True)
+    """The options dataclass: its :func:`~ar3cli.fix.settings.setting` fields are the command's own
+    options, and the command builds it from their values (its ``__post_init__`` checks them and
+    derives what the plan reads). A field named ``verify`` is the ``--verify`` switch."""
+    help: str = field(default="", kw_only=True)
+    """The command's ``--help``: its first line is the summary ``ar3cli --help`` lists."""
+    timeout: float | None = field(default=None, kw_only=True)
+    """The ``--timeout`` default of a fixer that starts a child process; None: no ``--timeout``."""
+    session: Callable[[Options, FixerArgs], AbstractContextManager[FixerArgs]] | None = field(default=None,
+                                                                                          kw_only=True)
+    """Wraps the run, for a fixer that needs more than its options: it may adjust the shared
+    arguments (it yields the ones to use) and clean up after the run, whatever its end."""
+
+    def run(self, options: Options, args: FixerArgs) -> int:
+        """Run this fixer with ``options`` (an instance of :attr:`options`) on ``args``; the exit code."""
+        verify = bool(getattr(options, "verify", False))
+        if self.session is None:
+            return run_fixer(self, options, args, verify=verify)
+        with self.session(options, args) as session_args:
+            return run_fixer(self, options, session_args, verify=verify)
 
 
 @dataclass(frozen=True)

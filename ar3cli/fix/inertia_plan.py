@@ -25,31 +25,76 @@ from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass, field
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from ar3cli.errors import UserError
-from ar3cli.fix import geometry_mass as inertia
 from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, number, same_numbers
-from ar3cli.lint.rules.inertia import inertia_implausible
-from ar3cli.maths import mass_properties as mp
+from ar3cli.fix.settings import setting
 from ar3cli.urdf.edits import Document
-from ar3cli.urdf.model import Model
+
+if TYPE_CHECKING:  # numpy, the geometry and the lint rules are imported when a plan runs, not for --help
+    import numpy as np
+
+    from ar3cli.fix import geometry_mass as inertia
+    from ar3cli.maths import mass_properties as mp
+    from ar3cli.urdf.model import Model
 
 TENSOR_KEYS = ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")
-IMPLAUSIBLE_CODES = frozenset({inertia_implausible.code})
-"""Lint codes that flag a valid but implausible ``<inertial>``: recomputed only on request."""
+IMPLAUSIBLE_CODES = frozenset({"I007"})
+"""Lint codes that flag a valid but implausible ``<inertial>`` (``inertia_implausible``): recomputed only
+on request."""
 INCLUDE_IMPLAUSIBLE = "--include-implausible"
+
+
+SMALLEST_MASS = 1e-9
+"""A microgram: below it, masses and inertias are round-off, not a robot (``--mass`` and ``--total-mass``;
+``--mass arm=1e-320`` wrote inertias of 1e-323, subnormal numbers)."""
+DENSITY_RANGE = (0.01, 1e6)
+"""Densities that are a material, in kg/m^3: expanded foams and aerogels start near 1, osmium is
+22,590; the margins take units slips the user meant. Outside it the inertia written is no
+physics (``--density 1e-320`` gave masses of 1e-323 kg, subnormal numbers that underflow to 0)."""
 
 
 @dataclass
 class InertiaOptions:
-    links: list[str] | None = None
-    all_links: bool = False
-    density: float | None = None
-    masses: dict[str, float] = field(default_factory=dict)
-    total_mass: float | None = None
-    include_implausible: bool = False
+    """fix-inertia's own options (each :func:`~ar3cli.fix.settings.setting` is one), checked, and
+    the link names and masses they give."""
+
+    links: str | None = setting("--links", default=None, help="Comma-separated links to recompute "
+                                "(default: the links the linter flags as invalid).")
+    all_links: bool = setting("--all", default=False, help="Recompute every link that has geometry.")
+    include_implausible: bool = setting(
+        INCLUDE_IMPLAUSIBLE, default=False,
+        help="Also recompute links whose inertia is valid but implausible for their geometry (I007: "
+             "often a hand-tuned value or a deliberate placeholder). By default they are left alone "
+             "and listed.")
+    density: float | None = setting("--density", metavar="KG_PER_M3", default=None,
+                                    help="Density for links without a valid mass.")
+    mass: list[str] | None = setting("--mass", metavar="LINK=KG", default=None,
+                                     help="Mass of one link (repeatable); overrides the file.")
+    total_mass: float | None = setting("--total-mass", metavar="KG", default=None,
+                                       help="The robot's total mass: what the known masses leave "
+                                            "is spread over links without one, by volume.")
+    link_names: list[str] | None = field(default=None, init=False)
+    """``--links`` split at its commas."""
+    masses: dict[str, float] = field(default_factory=dict, init=False)
+    """``--mass`` as link -> kg."""
+
+    def __post_init__(self) -> None:
+        low, high = DENSITY_RANGE
+        if self.density is not None and not low <= self.density <= high:
+            raise UserError(f"--density {self.density}: must be a density between {low:g} and {high:g} kg/m^3 "
+                            f"(e.g. 1200 for PLA, 2700 for aluminium, 7850 for steel)")
+        if self.total_mass is not None and not SMALLEST_MASS <= self.total_mass < math.inf:
+            raise UserError(f"--total-mass {self.total_mass}: must be a mass of at least {SMALLEST_MASS:g} kg")
+        if self.links is not None and self.all_links:
+            raise UserError("--links and --all exclude each other")
+        if self.include_implausible and (self.links is not None or self.all_links):
+            raise UserError("--include-implausible widens the default selection; --links and --all already "
+                            "choose the links")
+        if self.links is not None:
+            self.link_names = [name.strip() for name in self.links.split(",") if name.strip()]
+        self.masses = parse_masses(self.mass)
 
 
 @dataclass
@@ -74,11 +119,6 @@ class _Target:
     """Why no mass source applies (shown instead of the generic "give --density ..." when set)."""
 
 
-SMALLEST_MASS = 1e-9
-"""A microgram: below it, masses and inertias are round-off, not a robot (``--mass`` and ``--total-mass``;
-``--mass arm=1e-320`` wrote inertias of 1e-323, subnormal numbers)."""
-
-
 def parse_masses(values: list[str] | None) -> dict[str, float]:
     """``LINK=KG`` pairs; malformed ones, and masses below :data:`SMALLEST_MASS`, raise UserError."""
     masses: dict[str, float] = {}
@@ -98,13 +138,13 @@ def parse_masses(values: list[str] | None) -> dict[str, float]:
 
 def _select(model, options: InertiaOptions) -> tuple[dict[str, str], list[LeftAlone]]:
     """``({link: why it is recomputed}, [flagged links left alone])``."""
-    for name in [*(options.links or []), *options.masses]:
+    for name in [*(options.link_names or []), *options.masses]:
         if model.link(name) is None:
             raise UserError(f"{model.path}: no link named {name!r}")
     if options.all_links:
         return {link.name: "--all" for link in model.links}, []
-    if options.links:
-        return {name: "--links" for name in options.links}, []
+    if options.link_names:
+        return {name: "--links" for name in options.link_names}, []
     selected: dict[str, str] = {}
     left_alone: list[LeftAlone] = []
     for name, reason in links_needing_inertia(model).items():
@@ -127,6 +167,9 @@ def _left_alone_note(left_alone: list[LeftAlone]) -> str:
 
 
 def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
+    from ar3cli.fix import geometry_mass as inertia
+    from ar3cli.maths import mass_properties as mp
+
     plan = FixPlan()
     cache: dict = {}
     selected, left_alone = _select(model, options)
@@ -235,6 +278,11 @@ def _element(link) -> str:
 
 
 def _write_frame_link(document: Document, plan: FixPlan, link, reason: str) -> None:
+    import numpy as np
+
+    from ar3cli.fix import geometry_mass as inertia
+    from ar3cli.maths import mass_properties as mp
+
     props = mp.MassProperties(inertia.FRAME_LINK_MASS, np.zeros(3), np.eye(3) * inertia.FRAME_LINK_INERTIA)
     source = "frame link (no geometry, fixed joint): tiny inertial, see docs/commands/fix-inertia.md"
     _write_inertial(document, plan, link, props, source, source)
@@ -321,6 +369,8 @@ def _same_numbers(old: str | None, new: str) -> bool:
 def _clean(values: np.ndarray, relative: float = 0.0, absolute: float = 0.0) -> np.ndarray:
     """Zero out rounding noise: entries below ``absolute`` or ``relative`` x the largest entry
     (rotating a diagonal tensor by rpy angles leaves ~1e-17 off-diagonal residue)."""
+    import numpy as np
+
     array = np.array(values, dtype=float)
     scale = float(np.max(np.abs(array))) if array.size else 0.0
     array[np.abs(array) < max(absolute, relative * scale)] = 0.0
@@ -363,6 +413,14 @@ def _owning_link(element):
     return element
 
 
-FIXER = Fixer[InertiaOptions]("fix-inertia", plan_inertia)
-"""What ``ar3cli fix-inertia`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
-:func:`plan_inertia`."""
+FIXER = Fixer[InertiaOptions]("fix-inertia", plan_inertia, options=InertiaOptions, help="""\
+Recompute mass, centre of mass and inertia tensor of links from their geometry.
+
+By default it fixes only links whose inertia is invalid (missing, mass <= 0, not positive
+definite, A + B < C, all zero) and lists the valid but implausible ones (I007) it left alone;
+--include-implausible recomputes those too.
+Edits only the fixed `<inertial>` elements, byte for byte, and writes atomically. A link
+without a valid mass needs --density, --mass or --total-mass: there is no default density.
+""")
+"""``ar3cli fix-inertia``: :func:`plan_inertia` (nothing to verify in PyBullet: the lint of the result
+is the check)."""

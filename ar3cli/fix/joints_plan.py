@@ -23,13 +23,15 @@ to a rule's heuristic changes the fixer with it):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
 from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
+from ar3cli.fix.settings import require_positive, setting
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.urdf.edits import Document
-from ar3cli.urdf.joint_limits_yaml import YamlLimits
+from ar3cli.urdf.joint_limits_yaml import YamlLimits, read_joint_limits
 
 INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
 """The lint rules whose findings fix-joints acts on."""
@@ -41,10 +43,24 @@ SAME_NUMBER = 1e-12
 
 @dataclass
 class JointsOptions:
-    effort: float | None = None
-    velocity: float | None = None
-    limits: dict[str, YamlLimits] | None = None
-    limits_path: Path | None = None
+    """fix-joints' own options (each :func:`~ar3cli.fix.settings.setting` is one), and the limits read."""
+
+    effort: float | None = setting("--effort", default=None,
+                                   help="Effort (N*m or N) to add where a `<limit>` has none (J007).")
+    velocity: float | None = setting("--velocity", default=None,
+                                     help="Velocity (rad/s or m/s) to add where a `<limit>` has none (J007).")
+    limits_path: Path | None = setting(
+        "--limits-from", metavar="JOINT_LIMITS_YAML", default=None,
+        help="MoveIt joint_limits.yaml: its max_effort / max_velocity fill a `<limit>` without them "
+             "(before --effort / --velocity).")
+    verify: bool = setting("--verify/--no-verify", default=True,
+                           help="After writing, load the result in PyBullet and read the joints back.")
+    limits: dict[str, YamlLimits] | None = field(default=None, init=False)
+    """``--limits-from``'s joints, read once."""
+
+    def __post_init__(self) -> None:
+        require_positive(effort=self.effort, velocity=self.velocity)
+        self.limits = read_joint_limits(self.limits_path) if self.limits_path is not None else None
 
 
 def flagged_joints(model, code: str) -> set[str]:
@@ -223,6 +239,13 @@ def _checks_in_pybullet(model, joints: dict) -> list[dict]:
     return checks
 
 
-FIXER = Fixer[JointsOptions]("fix-joints", plan_joints, verify)
-"""What ``ar3cli fix-joints`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
-:func:`plan_joints`, then :func:`verify` with ``--verify``."""
+FIXER = Fixer[JointsOptions]("fix-joints", plan_joints, verify, options=JointsOptions, timeout=DEFAULT_TIMEOUT_S,
+                             help="""\
+Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
+
+Inverted limits (J003) are swapped; revolute limits in degrees (J005) become radians; a
+non-unit axis (J010) is normalised; a `<limit>` without effort or velocity (J007) gets them
+from --limits-from or --effort/--velocity. A zero axis (J009) cannot be fixed automatically:
+it is reported, with what to do. Only the changed attributes are edited.
+""")
+"""``ar3cli fix-joints``: :func:`plan_joints`, then :func:`verify` with ``--verify``."""

@@ -19,11 +19,15 @@ loaded from the file the old URI pointed to.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import contextlib
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, verified_in_pybullet
+from ar3cli.fix.driver import Change, Fixer, FixerArgs, FixPlan, Skipped, check_row, verified_in_pybullet
+from ar3cli.fix.settings import setting
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.urdf.edits import Document
 
 FILENAME_ELEMENTS = ("mesh", "texture")
@@ -32,8 +36,29 @@ FILENAME_ELEMENTS = ("mesh", "texture")
 
 @dataclass
 class MeshPathOptions:
-    packages: dict[str, Path] = field(default_factory=dict)
+    """fix-mesh-paths' own options (each :func:`~ar3cli.fix.settings.setting` is one), and the packages
+    they name."""
+
+    package: list[str] = setting(
+        "--package", metavar="NAME=DIR",
+        help="The package the meshes belong to: a URI whose file lies under DIR becomes "
+             "package://NAME/PATH, PATH relative to DIR (repeatable; required).")
+    verify: bool = setting("--verify/--no-verify", default=True,
+                           help="After writing, load the result in PyBullet and check each rewritten mesh "
+                                "comes from the same file.")
+    packages: dict[str, Path] = field(default_factory=dict, init=False)
     """NAME -> DIR, in the order given."""
+
+    def __post_init__(self) -> None:
+        self.packages = parse_packages(self.package)
+
+
+@contextlib.contextmanager
+def with_packages(options: MeshPathOptions, args: FixerArgs) -> Iterator[FixerArgs]:
+    """The run of fix-mesh-paths: every ``--package NAME=DIR`` is also a ``--package-path``, so the
+    model resolves the URIs the fix writes (given before the user's own ``--package-path``)."""
+    specs = [f"{name}={folder}" for name, folder in options.packages.items()]
+    yield replace(args, package_path=specs + list(args.package_path or []))
 
 
 def parse_packages(items: list[str] | None) -> dict[str, Path]:
@@ -206,6 +231,14 @@ def _real(name: bytes) -> str:
     return str(Path(text).resolve()) if text else ""
 
 
-FIXER = Fixer[MeshPathOptions]("fix-mesh-paths", plan_mesh_paths, verify)
-"""What ``ar3cli fix-mesh-paths`` runs through :func:`~ar3cli.fix.driver.run_fixer`:
-:func:`plan_mesh_paths`, then :func:`verify` with ``--verify``."""
+FIXER = Fixer[MeshPathOptions]("fix-mesh-paths", plan_mesh_paths, verify, options=MeshPathOptions,
+                                timeout=DEFAULT_TIMEOUT_S, session=with_packages, help="""\
+Rewrite machine-bound mesh and texture URIs to `package://NAME/...`, byte for byte, atomically.
+
+Absolute paths, `file://` URIs, `package:///` URIs (no package name) and paths relative to
+the URDF are rewritten when the file they point to lies under a --package DIR, after checking
+that the new URI resolves to the same file with `--package-path NAME=DIR`. URIs that do not
+resolve, or point outside every DIR, are reported and left alone.
+""")
+"""``ar3cli fix-mesh-paths``: :func:`plan_mesh_paths` inside :func:`with_packages`, then :func:`verify`
+with ``--verify``."""
