@@ -121,15 +121,19 @@ def sample_collisions(
 
 
 def _report_modules(format: str) -> None:
-    """Import what the report in ``format`` needs: run while the pybullet child samples, it costs no
-    wall time (after the child, the report's modules and rich, for the heat map, took ~40 ms)."""
+    """Import what the report in ``format`` needs, while the pybullet child samples: then it costs no
+    wall time (measured on the panda: the report's modules, and rich's for the heat map, took ~45 ms
+    after the child; rich's emoji table alone ~13 ms, loaded at the first line printed). A module
+    that is missing (rich reorganised) is simply imported later, when used, or not at all."""
+    import contextlib
     import importlib
 
     modules = ["ar3cli.collisions.matrix_report", "ar3cli.output.formats"]
     if format != "json":  # the heat map is a rich renderable: text output goes through a rich console
-        modules += ["rich.console", "rich.text", "rich.table", "rich.box", "rich.padding"]
+        modules += ["rich.console", "rich.text", "rich.table", "rich.box", "rich.padding", "rich._emoji_codes"]
     for module in modules:
-        importlib.import_module(module)
+        with contextlib.suppress(ImportError):  # a warm-up only
+            importlib.import_module(module)
 
 
 def _check_outputs(srdf: Path | None, pybullet_filter: Path | None, png: Path | None,
