@@ -3,10 +3,10 @@ limit configurations, count the uniform samples, classify every pair like MoveIt
 
 from __future__ import annotations
 
+import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-
-import numpy as np
 
 from ar3cli.collisions import matrix as cm
 from ar3cli.errors import UserError
@@ -38,13 +38,14 @@ class MatrixRun:
 
 @dataclass
 class _Counted:
-    """What the pybullet child sends back (plain data: it is pickled)."""
+    """What the pybullet child sends back (plain data: it is pickled; lists, not numpy arrays, so that
+    this process never imports numpy)."""
 
     links: list[str]
     pairs: list[tuple[int, int]]
     unsampled: set[int]
-    counts: np.ndarray
-    checked: np.ndarray
+    counts: list[int]
+    checked: list[int]
     home_hits: set[int]
     limit_hits: dict[int, list[str]]
     limit_configurations: int
@@ -53,15 +54,18 @@ class _Counted:
     jobs: int
 
 
-def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, always_threshold: float) -> MatrixRun:
+def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, always_threshold: float,
+                  meanwhile: Callable[[], None] | None = None) -> MatrixRun:
     """The self-collision matrix of ``model``; UserError when it has fewer than two links with
-    collision geometry (the matrix would be empty)."""
+    collision geometry (the matrix would be empty). ``meanwhile()`` runs here while the pybullet
+    child samples (the caller's report imports: off the critical path)."""
     from ar3cli.sim.adjacency import adjacent_pairs, collision_links
     from ar3cli.sim.session import run_pybullet
 
     if len(collision_links(model)) < 2:
         raise UserError(no_pairs_message(model))
-    counted = run_pybullet(lambda: _count(model, samples, seed, jobs, always_threshold), model)
+    counted = run_pybullet(lambda: _count(model, samples, seed, jobs, always_threshold), model,
+                           meanwhile=meanwhile)
     adjacent = adjacent_pairs(model, counted.links)
     results = cm.classify(counted.links, counted.pairs, counted.counts, samples, adjacent, counted.home_hits,
                           counted.limit_hits, always_threshold, counted.unsampled, counted.checked)
@@ -75,6 +79,9 @@ def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, alway
 def _count(model: Model, samples: int, seed: int, jobs: int | None, always_threshold: float) -> _Counted:
     """In the pybullet child: home and limit configurations, then the uniform samples, timed; a pair
     stops being counted once its category is decided (:mod:`ar3cli.collisions.rounds`)."""
+    # numpy is first imported here, in the child; OpenBLAS would start a thread per CPU that spins
+    # for nothing (no linear algebra is done): measured, importing numpy then takes twice the CPU
+    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     from ar3cli.collisions.checker import Checker
     from ar3cli.collisions.rounds import count_in_rounds
     from ar3cli.output.progress import progress_bar
@@ -106,7 +113,8 @@ def _count(model: Model, samples: int, seed: int, jobs: int | None, always_thres
             counts, checked, workers = count_in_rounds(checker, configs, settled, always_threshold, jobs,
                                                        progress=advance)
             elapsed = time.perf_counter() - start
-        return _Counted(checker.links, checker.pairs, checker.unsampled, counts, checked, home_hits, limit_hits,
+        return _Counted(checker.links, checker.pairs, checker.unsampled, counts.tolist(), checked.tolist(),
+                        home_hits, limit_hits,
                         len(limits), space.dof, elapsed, workers)
 
 

@@ -67,7 +67,7 @@ def report_stage(stage: str) -> None:
 
 
 def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], str | None] | None = None,
-                 timeout: float | None = None) -> Result:
+                 timeout: float | None = None, meanwhile: Callable[[], None] | None = None) -> Result:
     """``work()`` in a forked child; its result (which must pickle) or its exception comes back.
 
     A UserError in the child is raised here as it was; any other exception becomes a RuntimeError
@@ -77,10 +77,15 @@ def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], s
     that has not answered after ``timeout`` seconds (None: the command's ``--timeout``; 0 or
     infinity: no limit) is stopped and :class:`ChildTimeoutError` raised; a MemoryError in the child is
     :class:`OutOfMemoryError`. Ctrl-C or SIGTERM stops the child (after Ctrl-C, which it got too,
-    it gets a moment to finish; then SIGTERM, then SIGKILL).
+    it gets a moment to finish; then SIGTERM, then SIGKILL). ``meanwhile()``, if given, runs in this
+    process while the child works (after the fork, before waiting; where there is no fork, after
+    ``work()``): what the caller needs next, e.g. its report's imports, then costs no wall time.
     """
     if not can_fork():
-        return work()
+        result = work()
+        if meanwhile is not None:
+            meanwhile()
+        return result
     import time
 
     seconds = child_limits.timeout() if timeout is None else (timeout if 0 < timeout < float("inf") else None)
@@ -91,6 +96,8 @@ def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], s
         child_limits.prepare()
         with interrupts_deferred() as mask:  # a Ctrl-C between fork and bookkeeping would lose the child
             child = _start(work, folder, mask)
+        if meanwhile is not None:
+            meanwhile()
         data, finished = read_until(child[1].fileno(), None if seconds is None else time.monotonic() + seconds)
         answer, stage = _messages(data)
         if not finished:

@@ -410,15 +410,18 @@ def refuse_what_crashes_pybullet(model: Model) -> None:
                             f"crashes on names this long: keep names under {MAX_PYBULLET_NAME} characters")
 
 
-def run_pybullet(work: Callable[[], Result], model: Model, timeout: float | None = None) -> Result:
+def run_pybullet(work: Callable[[], Result], model: Model, timeout: float | None = None,
+                 meanwhile: Callable[[], None] | None = None) -> Result:
     """``work()`` (pybullet work on ``model``) in a forked child: a crash in pybullet's C code becomes
     a one-line :class:`~ar3cli.infra.isolation.CrashError` (exit 2) naming the file, what pybullet was
     doing, and the element known to cause it, instead of killing ar3cli. The child has the limits of
     :mod:`ar3cli.infra.child_limits`; after ``timeout`` seconds (None: the command's ``--timeout``) it
-    is stopped and that is a CrashError too (``... timed out after 120 s while loading it; ...``)."""
+    is stopped and that is a CrashError too (``... timed out after 120 s while loading it; ...``).
+    ``meanwhile()`` runs in this process while the child works (:func:`~ar3cli.infra.isolation.run_isolated`)."""
     from ar3cli.infra.isolation import run_isolated
 
-    return run_isolated(work, str(model.path), cause=lambda: known_crash_cause(model), timeout=timeout)
+    return run_isolated(work, str(model.path), cause=lambda: known_crash_cause(model), timeout=timeout,
+                        meanwhile=meanwhile)
 
 
 def _listing(names: Sequence[str], most: int = 5) -> str:
