@@ -114,14 +114,18 @@ def _home_of(tag: str) -> tuple[str, ...]:
 def _urdf_elements(root) -> Iterator:
     """Every element inside the robot's URDF part: <link>, <joint> and <material> children of <robot>
     and, below them, only children the schema knows (so an extension's subtree is never walked)."""
-    stack = [child for child in root if _local(child.tag) in SCHEMA["robot"][1]]
+    # ``child.tag in names`` is ``_local(child.tag) in names``: the schema's names are plain, and a
+    # comment's tag (a function) or a namespaced tag ("{uri}origin") is none of them.
+    stack = [child for child in root if child.tag in SCHEMA["robot"][1]]
     while stack:
         element = stack.pop()
         yield element
-        children = SCHEMA[element.tag][1]
-        if element.tag == "geometry":
+        tag = element.tag
+        if tag == "geometry":
             continue
-        stack.extend(child for child in element if _local(child.tag) in children)
+        children = SCHEMA[tag][1]
+        if children:
+            stack.extend(child for child in element if child.tag in children)
 
 
 def _schema_elements(ctx) -> tuple:
@@ -149,8 +153,11 @@ def _unknown_children(ctx) -> Iterator[tuple]:
             continue
         extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[1]
         for child in element:
-            tag = _local(child.tag)
-            if tag is None or tag in children or tag in extra:
+            tag = child.tag
+            if tag in children or tag in extra:
+                continue
+            tag = _local(tag)
+            if tag is None:
                 continue
             if tag in attrs:
                 continue  # S018: an attribute written as an element
@@ -207,7 +214,7 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
     for element in (ctx.model.root, *_schema_elements(ctx)):
         attrs = SCHEMA[element.tag][0]
         extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[0]
-        for name in element.attrib:
+        for name in element.keys():
             if name in attrs or name in extra or _local(name) is None:
                 continue
             guess = _closest(name, attrs)
@@ -230,9 +237,11 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
 def attribute_as_element(ctx) -> Iterator[Hit]:
     for element in _schema_elements(ctx):
         attrs = SCHEMA[element.tag][0]
+        if not attrs:
+            continue
         for child in element:
-            tag = _local(child.tag)
-            if tag is None or tag not in attrs or tag in SCHEMA[element.tag][1]:
+            tag = child.tag  # the attribute names are plain: a namespaced tag or a comment is none of them
+            if tag not in attrs or tag in SCHEMA[element.tag][1]:
                 continue
             value = " ".join((child.text or "").split()) or "..."
             yield Hit(f"{_owner(element)} has <{tag}> as a child element: parsers read only the attribute "
@@ -271,6 +280,8 @@ def missing_required_child(ctx) -> Iterator[Hit]:
 
 VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "deceleration": "limit", "jerk": "limit"}
 """Attribute -> element for the URDF 1.1/1.2 attributes (``<capsule>`` is G010's)."""
+VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
+"""The elements that may hold one (S020 reads only their attributes)."""
 
 
 @rule("S020", "undeclared-urdf-version", "info", "URDF 1.1/1.2 attribute in a file that does not declare it",
@@ -288,7 +299,9 @@ VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "dec
 def undeclared_urdf_version(ctx) -> Iterator[Hit]:
     model = ctx.model
     for element in _schema_elements(ctx):
-        for name in element.attrib:
+        if element.tag not in VERSION_FEATURE_HOLDERS:
+            continue
+        for name in element.keys():
             if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
                 yield Hit(f"{_owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
