@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 
-from ar3cli.maths.tensor_math import rpy_to_matrix
+from ar3cli.urdf.model import rpy_rotation
 
 Vector = tuple[float, float, float]
 Box = tuple[Vector, Vector]
@@ -45,7 +45,7 @@ def shape_bounds(shape) -> Box | None:
         half = tuple((b - a) / 2 for a, b in zip(low, high))  # type: ignore[assignment]
     if half is None or not all(map(math.isfinite, half)):
         return None
-    rotation = rpy_to_matrix(shape.origin.rpy)
+    rotation = rpy_rotation(shape.origin.rpy)
     world_centre = [sum(r * c for r, c in zip(row, centre)) + t for row, t in zip(rotation, shape.origin.xyz)]
     world_half = [sum(abs(r) * h for r, h in zip(row, half)) for row in rotation]
     return (tuple(c - h for c, h in zip(world_centre, world_half)),  # type: ignore[return-value]

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 from pathlib import Path
@@ -61,6 +61,18 @@ def parse_floats(text: str | None, count: int | None = None) -> tuple[float, ...
     return values
 
 
+def rpy_rotation(rpy: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
+    """:func:`~ar3cli.maths.tensor_math.rpy_to_matrix`, cached: robot files repeat a few orientations
+    ("0 0 0", "0 0 1.5708") thousands of times, and the bounds of every shape and the frames of every
+    joint ask for them (2,600 rotations for pybullet_data's 95 robots)."""
+    return _rpy_rotation(tuple(rpy))
+
+
+@lru_cache(maxsize=4096)
+def _rpy_rotation(rpy: tuple[float, ...]) -> tuple[tuple[float, float, float], ...]:
+    return rpy_to_matrix(rpy)
+
+
 def parse_float(text: str | None) -> float | None:
     """One number, or ``None`` when missing or malformed."""
     values = parse_floats(text, 1)
@@ -106,7 +118,7 @@ class Origin:
     @property
     def rotation(self) -> tuple[tuple[float, float, float], ...]:
         """The rotation matrix (rows): from the quaternion when one was given, else from ``rpy``."""
-        return quaternion_to_matrix(self.quat_xyzw) if self.quat_xyzw is not None else rpy_to_matrix(self.rpy)
+        return quaternion_to_matrix(self.quat_xyzw) if self.quat_xyzw is not None else rpy_rotation(self.rpy)
 
 
 @lru_cache(maxsize=1024)
