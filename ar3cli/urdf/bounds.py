@@ -46,10 +46,15 @@ def shape_bounds(shape) -> Box | None:
     if half is None or not all(map(math.isfinite, half)):
         return None
     rotation = rpy_rotation(shape.origin.rpy)
-    world_centre = [sum(r * c for r, c in zip(row, centre)) + t for row, t in zip(rotation, shape.origin.xyz)]
-    world_half = [sum(abs(r) * h for r, h in zip(row, half)) for row in rotation]
-    return (tuple(c - h for c, h in zip(world_centre, world_half)),  # type: ignore[return-value]
-            tuple(c + h for c, h in zip(world_centre, world_half)))
+    cx, cy, cz = centre
+    hx, hy, hz = half
+    # sum() of three-element lists: the same additions, in the same order, as sum() over the row's
+    # products (a generator per row cost more than the arithmetic; the box is asked for 1,400 times
+    # in a lint of pybullet_data's 95 robots)
+    world_centre = [sum([r0 * cx, r1 * cy, r2 * cz]) + t for (r0, r1, r2), t in zip(rotation, shape.origin.xyz)]
+    world_half = [sum([abs(r0) * hx, abs(r1) * hy, abs(r2) * hz]) for r0, r1, r2 in rotation]
+    return (tuple([c - h for c, h in zip(world_centre, world_half)]),  # type: ignore[return-value]
+            tuple([c + h for c, h in zip(world_centre, world_half)]))
 
 
 def mesh_unit(geometry) -> float | None:
@@ -71,6 +76,8 @@ def metric_mesh_bounds(geometry) -> Box | None:
     unit = mesh_unit(geometry) if scaled is not None else None
     if scaled is None or unit is None:
         return None
+    if unit == 1.0:  # every format but COLLADA, and most COLLADA files: v * 1.0 is v
+        return scaled
     low, high = scaled
     return tuple(v * unit for v in low), tuple(v * unit for v in high)  # type: ignore[return-value]
 
