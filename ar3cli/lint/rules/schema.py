@@ -214,7 +214,10 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
     for element in (ctx.model.root, *_schema_elements(ctx)):
         attrs = SCHEMA[element.tag][0]
         extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[0]
-        for name in element.keys():
+        names = element.keys()
+        if attrs.issuperset(names):
+            continue  # every attribute is the spec's (nearly always)
+        for name in names:
             if name in attrs or name in extra or _local(name) is None:
                 continue
             guess = _closest(name, attrs)
