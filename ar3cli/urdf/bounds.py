@@ -18,8 +18,10 @@ Box = tuple[Vector, Vector]
 """An axis-aligned box: (min corner, max corner)."""
 
 
-def shape_bounds(shape) -> Box | None:
+def shape_bounds(shape, mesh_box=None) -> Box | None:
     """Axis-aligned box of one visual/collision shape in its link's frame, or None if unknown.
+
+    ``mesh_box`` is :func:`scaled_mesh_bounds` (the default) or a cached version of it (the lint context's).
 
     The shape's own box (centre ``c``, half-extents ``h``) moved by its origin ``(xyz, R)`` is
     centred on ``R c + xyz`` with half-extents ``|R| h``: the box around its 8 rotated corners.
@@ -37,7 +39,7 @@ def shape_bounds(shape) -> Box | None:
     elif geometry.kind == "sphere" and params.get("radius") is not None:
         half = (abs(params["radius"]),) * 3
     elif geometry.kind == "mesh":
-        scaled = metric_mesh_bounds(geometry)
+        scaled = metric_mesh_bounds(geometry, mesh_box)
         if scaled is None:
             return None
         low, high = scaled
@@ -69,10 +71,10 @@ def mesh_unit(geometry) -> float | None:
     return collada_unit(resolution.path)
 
 
-def metric_mesh_bounds(geometry) -> Box | None:
+def metric_mesh_bounds(geometry, mesh_box=None) -> Box | None:
     """The mesh's box in the shape frame in metres (file bounds times scale times the COLLADA unit),
-    or None when it cannot be read or its unit is unknown."""
-    scaled = scaled_mesh_bounds(geometry)
+    or None when it cannot be read or its unit is unknown. ``mesh_box``: as for :func:`shape_bounds`."""
+    scaled = (mesh_box or scaled_mesh_bounds)(geometry)
     unit = mesh_unit(geometry) if scaled is not None else None
     if scaled is None or unit is None:
         return None

@@ -7,7 +7,6 @@ from collections.abc import Iterator
 from pathlib import Path
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
-from ar3cli.urdf.bounds import scaled_mesh_bounds
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 
 MAX_PLAUSIBLE_EXTENT = 5.0
@@ -125,7 +124,7 @@ def mesh_units(ctx) -> Iterator[Hit]:
 
     seen: set[tuple] = set()
     for link, _shape, geometry in _meshes(ctx):
-        bounds = scaled_mesh_bounds(geometry)
+        bounds = ctx.scaled_mesh_bounds(geometry)
         if bounds is None:
             continue
         extent = [b - a for a, b in zip(*bounds)]

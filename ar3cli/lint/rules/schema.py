@@ -304,7 +304,7 @@ def undeclared_urdf_version(ctx) -> Iterator[Hit]:
     for element in _schema_elements(ctx):
         if element.tag not in VERSION_FEATURE_HOLDERS:
             continue
-        for name in element.keys():
+        for name in element.keys():  # noqa: SIM118 - an lxml element: iterating it gives its children
             if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
                 yield Hit(f"{_owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
