@@ -249,9 +249,7 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
-    static = [rule for rule in rules if not rule.needs_sim]
-    simulated = [rule for rule in rules if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
-    in_mujoco = [rule for rule in rules if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
+    static, simulated, in_mujoco = _partition(rules)
     findings = _run_rules(model, shown, static, options)
     error = None
     if simulated or in_mujoco:
@@ -268,6 +266,22 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
                 error = exc.message
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
+
+
+def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
+    """(static rules with a check, PyBullet rules, MuJoCo rules) of ``rules``; sorted out once per
+    list, not once per file (a bulk lint hands every file the same list)."""
+    global _PARTITIONED
+    given = tuple(rules)
+    if _PARTITIONED is None or _PARTITIONED[0] != given:  # the same rules: an identity check each
+        static = [rule for rule in given if not rule.needs_sim and rule.check is not None]
+        simulated = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
+        in_mujoco = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
+        _PARTITIONED = (given, (static, simulated, in_mujoco))
+    return _PARTITIONED[1]
+
+
+_PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
 
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
