@@ -53,8 +53,9 @@ EngineOption = Annotated[Engine, typer.Option(
 NoConfigOption = Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
 JobsOption = Annotated[Optional[int], typer.Option(
     "--jobs", "-j", min=1, show_default=False,
-    help="Processes that share the files, at most one per CPU. Default on Linux: one per 24 files (per 2 with "
-         "--sim), at most 8; elsewhere 1. The output is the same for any value.")]
+    help="Processes that share the files, at most one per CPU. Default on Linux: one per 24 files or per 256 KB "
+         "of them, whichever is more (per 2 files with --sim), at most 8; elsewhere 1. The output is the same for "
+         "any value.")]
 NoCacheOption = Annotated[bool, typer.Option(
     "--no-cache", help="Check every file again instead of reusing the findings of unchanged files from earlier "
                        "runs (also AR3CLI_NO_CACHE=1).")]

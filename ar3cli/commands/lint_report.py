@@ -39,7 +39,7 @@ def lint_document(path: Path, package_path: list[str] | None, xacro_arg: list[st
     from ar3cli.lint.config import load_config
     from ar3cli.lint.engine import LintOptions, lint_paths, summarize
     from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
+    from ar3cli.urdf.xacro_args import parse_xacro_args
 
     config = load_config()
     try:

@@ -97,7 +97,7 @@ def lint_urdf(
     from ar3cli.lint.rules import validate_patterns
     from ar3cli.urdf.loading import apply_xacro_options
     from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
+    from ar3cli.urdf.xacro_args import parse_xacro_args
 
     if Engine(engine) is not Engine.pybullet and not sim:
         raise UserError("--engine chooses the simulator of --sim: add --sim")

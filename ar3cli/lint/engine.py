@@ -120,6 +120,12 @@ hand its findings back; a static lint of a file ~5 ms with lint v3's rules, ~100
 are read for the first time). The number is also in lint-urdf's --help and docs/commands/lint-urdf.md."""
 SIM_FILES_PER_WORKER = 2
 """With --sim a file takes a few hundred milliseconds: two files repay a process."""
+BYTES_PER_WORKER = 256 * 1024
+"""... or a process per this many bytes of robot files, when that gives more: a static lint costs
+~0.4 µs per byte of URDF (pybullet_data's 95 files, 0.7 MB: ~0.3 s), so 256 KB is ~0.1 s of work, and
+large robots are few files: 40 of example-robot-data's, 1.5 MB, took 3.0 s with an empty mesh cache in
+one process and 1.9 s in two (0.7 and 0.45 s with the cache warm). Also in lint-urdf's --help and
+docs/commands/lint-urdf.md."""
 
 
 def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = True,
@@ -130,23 +136,38 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     ``jobs`` processes share the files (None: one per CPU for large batches, see
     :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it.
     """
-    from ar3cli.infra.process_pool import map_in_processes, worker_count
+    from ar3cli.infra.process_pool import map_in_processes
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
     files = collect_files(paths)
-    workers = worker_count(jobs, len(files), SIM_FILES_PER_WORKER if options.sim else FILES_PER_WORKER)
+    sizes = [_size(path) for path in files]
+    workers = _workers(jobs, sizes, options.sim)
     if workers <= 1:
         return [lint_file(path, rules, options, cache) for path in files]
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
-    order = balanced_order([_size(path) for path in files], workers)
+    order = balanced_order(sizes, workers)
     outcomes = map_in_processes(job, [files[index] for index in order], workers, what="a lint worker")
     results: list[LintResult] = [None] * len(files)  # type: ignore[list-item]
     for index, (result, learned) in zip(order, outcomes):
         merge_learned(learned)
         results[index] = result
     return results
+
+
+def _workers(jobs: int | None, sizes: list[int], sim: bool) -> int:
+    """Processes for files of these ``sizes``: ``--jobs``, else one per :data:`FILES_PER_WORKER` files
+    or per :data:`BYTES_PER_WORKER` bytes, whichever is more (one per :data:`SIM_FILES_PER_WORKER`
+    files with ``--sim``), within :func:`~ar3cli.infra.process_pool.worker_count`'s limits."""
+    from ar3cli.infra.process_pool import worker_count
+
+    if sim:
+        return worker_count(jobs, len(sizes), SIM_FILES_PER_WORKER)
+    by_files = worker_count(jobs, len(sizes), FILES_PER_WORKER)
+    if jobs is not None:
+        return by_files
+    return max(by_files, min(len(sizes), worker_count(None, sum(sizes), BYTES_PER_WORKER)))
 
 
 def balanced_order(sizes: list[int], workers: int) -> list[int]:
@@ -228,9 +249,7 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
-    static = [rule for rule in rules if not rule.needs_sim]
-    simulated = [rule for rule in rules if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
-    in_mujoco = [rule for rule in rules if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
+    static, simulated, in_mujoco = _partition(rules)
     findings = _run_rules(model, shown, static, options)
     error = None
     if simulated or in_mujoco:
@@ -247,6 +266,22 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
                 error = exc.message
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
+
+
+def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
+    """(static rules with a check, PyBullet rules, MuJoCo rules) of ``rules``; sorted out once per
+    list, not once per file (a bulk lint hands every file the same list)."""
+    global _PARTITIONED
+    given = tuple(rules)
+    if _PARTITIONED is None or _PARTITIONED[0] != given:  # the same rules: an identity check each
+        static = [rule for rule in given if not rule.needs_sim and rule.check is not None]
+        simulated = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
+        in_mujoco = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
+        _PARTITIONED = (given, (static, simulated, in_mujoco))
+    return _PARTITIONED[1]
+
+
+_PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
 
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:

@@ -118,7 +118,12 @@ def dae_bounds(path: Path, data: bytes | None = None) -> Bounds | None:
             picked = indices.reshape(-1, stride)[:, int(vertex.get("offset", 0))] if indices.size % stride == 0 else None
             if picked is None or picked.max() >= len(points) or picked.min() < 0:
                 raise Unsupported("indices")
-            used.append(points[np.unique(picked)])
+            # The rows the indices name, each once, in index order: what points[np.unique(picked)] gives,
+            # by a mask in linear time instead of a hash or sort of every index (a quarter of the time
+            # of reading example-robot-data's COLLADA meshes).
+            mask = np.zeros(len(points), dtype=bool)
+            mask[picked] = True
+            used.append(points[mask])
         positions[gid] = np.vstack(used) if used else np.zeros((0, 3))
         return positions[gid]
     scene = root.find("{*}scene/{*}instance_visual_scene")

@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,14 +15,20 @@ if TYPE_CHECKING:
 
 def apply_xacro_options(trusted: bool, env_names: list[str] | None) -> None:
     """Make ``--xacro trusted`` and ``--xacro-env NAME`` the policy of this run's expansions
-    (:func:`~ar3cli.urdf.xacro_expand.set_policy`); a malformed name raises UserError."""
-    from ar3cli.urdf.xacro_expand import set_policy
-    from ar3cli.urdf.xacro_safe import XacroPolicy
+    (:func:`~ar3cli.urdf.xacro_expand.set_policy`); a malformed name raises UserError.
 
+    The default policy (safe mode, no variable) is what xacro_expand starts with: while that module
+    is not imported yet there is nothing to set, and a run over plain ``.urdf`` files never imports
+    xacro's machinery (~5 ms of start-up)."""
     names = [name.strip() for name in env_names or []]
     for name in names:
         if not name or "=" in name or "$" in name or " " in name:
             raise UserError(f"--xacro-env expects an environment variable name, got {name!r}")
+    if not trusted and not names and "ar3cli.urdf.xacro_expand" not in sys.modules:
+        return
+    from ar3cli.urdf.xacro_expand import set_policy
+    from ar3cli.urdf.xacro_safe import XacroPolicy
+
     set_policy(XacroPolicy(trusted=trusted, env=frozenset(names)))
 
 

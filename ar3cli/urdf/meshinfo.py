@@ -4,7 +4,8 @@ STL (binary and ASCII) and OBJ vertices are read in plain Python: importing nump
 and trimesh ~0.5 s, more than reading the meshes of a typical robot (the Franka Panda's 18 OBJ
 files, 52k vertices, take ~25 ms), so a static lint never imports either for them. Binary STL
 files of at least :data:`NUMPY_MIN_BYTES` are read with numpy, where its import pays for
-itself. COLLADA .dae is read by :mod:`ar3cli.urdf.dae` (positions and node transforms, numpy), and
+itself, and every binary STL once numpy is imported anyway (a COLLADA file was read): both readers
+give the same box, bit for bit. COLLADA .dae is read by :mod:`ar3cli.urdf.dae` (positions and node transforms, numpy), and
 other formats fall back to trimesh, imported only then. Results are
 cached per path for the process (bulk lints share meshes between models) and on disk between runs
 (:mod:`ar3cli.infra.file_cache`, keyed by path, modification time and size).
@@ -151,7 +152,7 @@ def _mesh_bounds(path: Path, _mtime_ns: int, size: int) -> Bounds | None:
         if suffix == ".stl":
             data = read_mesh(path)
             if _binary_stl_count(data) is not None:
-                if size >= NUMPY_MIN_BYTES:
+                if size >= NUMPY_MIN_BYTES or "numpy" in sys.modules:  # imported already (a .dae): no cost
                     return _numpy_stl_bounds(data)
                 parsed = _stl_columns(data)
             else:
@@ -273,7 +274,13 @@ def _numpy_stl_bounds(data: bytes) -> Bounds | None:
     vertices = vertices[np.isfinite(vertices).all(axis=1)]
     if len(vertices) == 0:
         return None
-    return tuple(vertices.min(axis=0).tolist()), tuple(vertices.max(axis=0).tolist())  # type: ignore[return-value]
+    # The first of equal extremes, as Python's min() and max() in the plain reader pick them: 0.0 and
+    # -0.0 are equal, and numpy's min() returns the last, so a mesh with both would get another sign
+    # of zero from each reader. With argmin/argmax both readers give the same floats, bit for bit.
+    columns = np.arange(3)
+    low = vertices[vertices.argmin(axis=0), columns].tolist()
+    high = vertices[vertices.argmax(axis=0), columns].tolist()
+    return (low[0], low[1], low[2]), (high[0], high[1], high[2])
 
 
 def _dae_bounds(path: Path) -> Bounds | None:

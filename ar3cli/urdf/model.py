@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property, lru_cache
 from pathlib import Path
@@ -61,6 +61,18 @@ def parse_floats(text: str | None, count: int | None = None) -> tuple[float, ...
     return values
 
 
+def rpy_rotation(rpy: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
+    """:func:`~ar3cli.maths.tensor_math.rpy_to_matrix`, cached: robot files repeat a few orientations
+    ("0 0 0", "0 0 1.5708") thousands of times, and the bounds of every shape and the frames of every
+    joint ask for them (2,600 rotations for pybullet_data's 95 robots)."""
+    return _rpy_rotation(tuple(rpy))
+
+
+@lru_cache(maxsize=4096)
+def _rpy_rotation(rpy: tuple[float, ...]) -> tuple[tuple[float, float, float], ...]:
+    return rpy_to_matrix(rpy)
+
+
 def parse_float(text: str | None) -> float | None:
     """One number, or ``None`` when missing or malformed."""
     values = parse_floats(text, 1)
@@ -87,7 +99,11 @@ class Origin:
 
     @classmethod
     def from_parent(cls, parent) -> Origin:
-        element = parent.find("origin") if parent is not None else None
+        return cls.from_element(parent.find("origin") if parent is not None else None)
+
+    @classmethod
+    def from_element(cls, element) -> Origin:
+        """The origin an ``<origin>`` element (or None: absent) gives."""
         if element is None:
             return cls()
         xyz = parse_floats(element.get("xyz", "0 0 0"), 3) or (0.0, 0.0, 0.0)
@@ -102,7 +118,7 @@ class Origin:
     @property
     def rotation(self) -> tuple[tuple[float, float, float], ...]:
         """The rotation matrix (rows): from the quaternion when one was given, else from ``rpy``."""
-        return quaternion_to_matrix(self.quat_xyzw) if self.quat_xyzw is not None else rpy_to_matrix(self.rpy)
+        return quaternion_to_matrix(self.quat_xyzw) if self.quat_xyzw is not None else rpy_rotation(self.rpy)
 
 
 @lru_cache(maxsize=1024)
@@ -380,19 +396,42 @@ def load_model(
                  joints=[_read_joint(element) for element in root.findall("joint")])
 
 
+def _first_children(element) -> dict[Any, Any]:
+    """Each child tag -> the first child with it: ``element.find(tag)`` for every tag at once.
+
+    One pass over the children instead of one ``find`` per name (lxml's ``find`` goes through its
+    ElementPath machinery, ~2.5 µs a call: loading pybullet_data's 95 robots asked ~12,000 times).
+    Only element tags are plain strings, so comments and namespaced children never match a URDF name.
+    """
+    found: dict[Any, Any] = {}
+    for child in element:
+        found.setdefault(child.tag, child)
+    return found
+
+
 def _read_link(element, resolver: PackageResolver) -> Link:
-    inertial_element = element.find("inertial")
+    visuals, collisions = [], []
+    inertial_element = None
+    for child in element:
+        tag = child.tag
+        if tag == "visual":
+            visuals.append(child)
+        elif tag == "collision":
+            collisions.append(child)
+        elif tag == "inertial" and inertial_element is None:
+            inertial_element = child
     inertial = None
     if inertial_element is not None:
-        mass_element = inertial_element.find("mass")
-        tensor_element = inertial_element.find("inertia")
+        parts = _first_children(inertial_element)
+        mass_element = parts.get("mass")
+        tensor_element = parts.get("inertia")
         tensor = None
         if tensor_element is not None:
             values = [parse_float(tensor_element.get(key)) for key in ("ixx", "ixy", "ixz", "iyy", "iyz", "izz")]
             if all(v is not None for v in values):
                 tensor = tuple(values)  # type: ignore[assignment]
         inertial = Inertial(
-            origin=Origin.from_parent(inertial_element),
+            origin=Origin.from_element(parts.get("origin")),
             mass=parse_float(mass_element.get("value")) if mass_element is not None else None,
             tensor=tensor,
             element=inertial_element,
@@ -400,19 +439,20 @@ def _read_link(element, resolver: PackageResolver) -> Link:
     return Link(
         name=element.get("name", ""),
         inertial=inertial,
-        visuals=tuple(_read_shape(e, "visual", resolver) for e in element.findall("visual")),
-        collisions=tuple(_read_shape(e, "collision", resolver) for e in element.findall("collision")),
+        visuals=tuple(_read_shape(e, "visual", resolver) for e in visuals),
+        collisions=tuple(_read_shape(e, "collision", resolver) for e in collisions),
         element=element,
     )
 
 
 def _read_shape(element, role: str, resolver: PackageResolver) -> Shape:
-    return Shape(role=role, origin=Origin.from_parent(element), geometry=_read_geometry(element, resolver),
-                 element=element)
+    parts = _first_children(element)
+    return Shape(role=role, origin=Origin.from_element(parts.get("origin")),
+                 geometry=_read_geometry(parts.get("geometry"), resolver), element=element)
 
 
-def _read_geometry(shape_element, resolver: PackageResolver) -> Geometry:
-    container = shape_element.find("geometry")
+def _read_geometry(container, resolver: PackageResolver) -> Geometry:
+    """The shape in a ``<geometry>`` element (None: the shape has none)."""
     if container is None:
         return Geometry(None, {}, None)
     children = [child for child in container if isinstance(child.tag, str)]
@@ -443,28 +483,29 @@ def _read_geometry(shape_element, resolver: PackageResolver) -> Geometry:
 
 
 def _read_joint(element) -> Joint:
-    limit_element = element.find("limit")
+    parts = _first_children(element)
+    limit_element = parts.get("limit")
     limit = None
     if limit_element is not None:
         limit = Limit(*(parse_float(limit_element.get(key)) for key in ("lower", "upper", "effort", "velocity")),
                       element=limit_element,
                       **{key: parse_float(limit_element.get(key)) for key in ("acceleration", "deceleration", "jerk")})
-    axis_element = element.find("axis")
+    axis_element = parts.get("axis")
     axis = parse_floats(axis_element.get("xyz"), 3) if axis_element is not None else None
-    mimic_element = element.find("mimic")
+    mimic_element = parts.get("mimic")
     mimic = None
     if mimic_element is not None:
         mimic = Mimic(mimic_element.get("joint", ""),
                       _finite_or(parse_float(mimic_element.get("multiplier")), 1.0),
                       _finite_or(parse_float(mimic_element.get("offset")), 0.0), mimic_element)
-    parent = element.find("parent")
-    child = element.find("child")
+    parent = parts.get("parent")
+    child = parts.get("child")
     return Joint(
         name=element.get("name", ""),
         type=element.get("type", ""),
         parent=parent.get("link") if parent is not None else None,
         child=child.get("link") if child is not None else None,
-        origin=Origin.from_parent(element),
+        origin=Origin.from_element(parts.get("origin")),
         axis=axis or (1.0, 0.0, 0.0),  # type: ignore[arg-type]
         axis_given=axis_element is not None,
         limit=limit,

@@ -20,7 +20,7 @@ import os
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
-from functools import lru_cache
+from functools import cached_property, lru_cache
 from pathlib import Path
 from urllib.parse import unquote
 
@@ -108,6 +108,15 @@ class PackageResolver:
         """Every path a resolution depended on, with its state when first looked at (the lint result
         cache stores these: the answer is stale when any of them changes)."""
 
+    @cached_property
+    def _ancestors(self) -> list[Path]:
+        """The file's folder and every folder above it, nearest first (``[base_dir, *base_dir.parents]``,
+        built once per resolver: ``parents`` makes each one anew by index, for every URI searched)."""
+        folders = [self.base_dir]
+        while folders[-1].parent != folders[-1]:
+            folders.append(folders[-1].parent)
+        return folders
+
     def _probe(self, path: Path) -> Path:
         """``path``, its state remembered in :attr:`probed` (call it before looking at the disk)."""
         key = str(path)
@@ -143,7 +152,7 @@ class PackageResolver:
         for prefix in self._ament_prefixes:
             if accept(prefix / "share" / name):
                 return prefix / "share" / name, tuple(tried)
-        for ancestor in [self.base_dir, *self.base_dir.parents]:
+        for ancestor in self._ancestors:
             if ancestor.name == name or self._package_name(ancestor) == name:
                 return ancestor, tuple(tried)
             sibling = self._probe(ancestor / name)
@@ -190,7 +199,7 @@ class PackageResolver:
 
     def _pybullet_search(self, uri: str, relative: str, tried: tuple[str, ...], problem: str) -> Resolution:
         """PyBullet's fallback: ``relative`` inside the file's folder and a few folders above."""
-        folders = [self.base_dir, *list(self.base_dir.parents)[:PYBULLET_SEARCH_LEVELS]]
+        folders = self._ancestors[:PYBULLET_SEARCH_LEVELS + 1]
         for folder in folders:
             candidate = folder / relative
             if str(candidate) not in tried:

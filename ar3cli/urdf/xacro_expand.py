@@ -30,18 +30,8 @@ from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import MAX_FILE_BYTES
 from ar3cli.output.report import log
 from ar3cli.urdf.packages import PackageResolver
+from ar3cli.urdf.xacro_args import parse_xacro_args  # noqa: F401 - its home before xacro_args.py; callers import it here
 from ar3cli.urdf.xacro_safe import ReadRoots, XacroPolicy, read_inside, safe_hooks
-
-
-def parse_xacro_args(items: list[str] | None) -> dict[str, str]:
-    """Turn repeated ``NAME:=VALUE`` options into a mapping; raises ValueError when malformed."""
-    mapping: dict[str, str] = {}
-    for item in items or []:
-        name, sep, value = item.partition(":=")
-        if not sep or not name.strip():
-            raise ValueError(f"--xacro-arg expects NAME:=VALUE, got {item!r}")
-        mapping[name.strip()] = value
-    return mapping
 
 
 class Origin(NamedTuple):

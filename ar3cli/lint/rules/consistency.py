@@ -47,25 +47,35 @@ def _diagonal(box: Box) -> float:
     return math.dist(box[0], box[1])
 
 
+# The arithmetic below sums three-element lists where it summed generators: the same additions in the
+# same order (so the same floats), without a generator per row; G014 composes and moves boxes for
+# every link.
+
+
 def _gap(a: Box, b: Box) -> float:
     """Distance between two axis-aligned boxes (0 when they touch or overlap)."""
-    return math.sqrt(sum(max(0.0, b[0][i] - a[1][i], a[0][i] - b[1][i]) ** 2 for i in range(3)))
+    (al, ah), (bl, bh) = a, b
+    return math.sqrt(sum([max(0.0, bl[0] - ah[0], al[0] - bh[0]) ** 2, max(0.0, bl[1] - ah[1], al[1] - bh[1]) ** 2,
+                          max(0.0, bl[2] - ah[2], al[2] - bh[2]) ** 2]))
 
 
 def _moved(box: Box, rotation, translation) -> Box:
     """The axis-aligned box around ``box`` rotated by ``rotation`` (rows) and moved by ``translation``."""
-    centre = [(lo + hi) / 2 for lo, hi in zip(*box)]
-    half = [(hi - lo) / 2 for lo, hi in zip(*box)]
-    c = [sum(r * v for r, v in zip(row, centre)) + t for row, t in zip(rotation, translation)]
-    h = [sum(abs(r) * v for r, v in zip(row, half)) for row in rotation]
-    return tuple(a - b for a, b in zip(c, h)), tuple(a + b for a, b in zip(c, h))  # type: ignore[return-value]
+    cx, cy, cz = [(lo + hi) / 2 for lo, hi in zip(*box)]
+    hx, hy, hz = [(hi - lo) / 2 for lo, hi in zip(*box)]
+    c = [sum([r0 * cx, r1 * cy, r2 * cz]) + t for (r0, r1, r2), t in zip(rotation, translation)]
+    h = [sum([abs(r0) * hx, abs(r1) * hy, abs(r2) * hz]) for r0, r1, r2 in rotation]
+    return tuple([a - b for a, b in zip(c, h)]), tuple([a + b for a, b in zip(c, h)])  # type: ignore[return-value]
 
 
 def _compose(outer, inner):
     """(R, t) of ``outer`` applied after ``inner``: x -> R_o (R_i x + t_i) + t_o."""
     (ro, to), (ri, ti) = outer, inner
-    rotation = tuple(tuple(sum(ro[i][k] * ri[k][j] for k in range(3)) for j in range(3)) for i in range(3))
-    translation = tuple(sum(ro[i][k] * ti[k] for k in range(3)) + to[i] for i in range(3))
+    (a0, a1, a2), (b0, b1, b2), (c0, c1, c2) = ri  # rows k = 0, 1, 2 of the inner rotation
+    t0, t1, t2 = ti
+    rotation = tuple([(sum([r0 * a0, r1 * b0, r2 * c0]), sum([r0 * a1, r1 * b1, r2 * c1]),
+                       sum([r0 * a2, r1 * b2, r2 * c2])) for r0, r1, r2 in ro])
+    translation = tuple([sum([r0 * t0, r1 * t1, r2 * t2]) + t for (r0, r1, r2), t in zip(ro, to)])
     return rotation, translation
 
 

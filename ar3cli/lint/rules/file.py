@@ -143,10 +143,17 @@ def number_problem(text: str, count: int) -> str | None:
       good=robot('<link name="base"><visual><origin xyz="0 0 0"/><geometry><box size="1 1 1"/></geometry></visual></link>'))
 def malformed_number(ctx) -> Iterator[Hit]:
     for element in ctx.model.root.iter(*NUMERIC_ATTRIBUTES):
-        for key, count in NUMERIC_ATTRIBUTES[element.tag].items():
-            text = element.get(key)
-            if text is None or ("$" in text and _SUBSTITUTION.search(text)):
+        spec = NUMERIC_ATTRIBUTES[element.tag]
+        found = []
+        for key, text in element.items():  # the attributes written (one or two), not every one the spec has
+            count = spec.get(key)
+            if count is None or ("$" in text and _SUBSTITUTION.search(text)):
                 continue  # unexpanded substitutions are F006's
             problem = number_problem(text, count)
             if problem:
-                yield Hit(f"<{element.tag} {key}=\"{text}\"> {problem}", element)
+                found.append((key, text, problem))
+        if len(found) > 1:
+            order = list(spec)
+            found.sort(key=lambda item: order.index(item[0]))  # reported in the spec's order, as ever
+        for key, text, problem in found:
+            yield Hit(f"<{element.tag} {key}=\"{text}\"> {problem}", element)

@@ -121,13 +121,17 @@ def _dense(mass: str, size: str = "0.1 0.1 0.1") -> str:
 def density_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
         highest, lowest = density_bounds(ctx, link)
-        where = link.inertial.element.find("mass") if link.inertial is not None else None
         if highest is not None and highest < MIN_DENSITY:
             yield Hit(f"link '{link.name}' is at most {highest:.3g} kg/m³ ({link.inertial.mass:g} kg in its collision "
-                      f"shapes): lighter than any solid material", where)
+                      f"shapes): lighter than any solid material", _mass_element(link))
         elif lowest is not None and lowest > MAX_DENSITY:
             yield Hit(f"link '{link.name}' is at least {lowest:.4g} kg/m³ ({link.inertial.mass:g} kg in its collision "
-                      f"shapes): denser than any material", where)
+                      f"shapes): denser than any material", _mass_element(link))
+
+
+def _mass_element(link):
+    """The link's ``<mass>`` element (where a density finding points), or None."""
+    return link.inertial.element.find("mass") if link.inertial is not None else None
 
 
 @rule("I014", "mass-tiny", "warning", "Moving link lighter than a gram",

@@ -16,6 +16,7 @@ from __future__ import annotations
 import difflib
 import functools
 from collections.abc import Iterator
+from typing import Any
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 from ar3cli.urdf.model import URDF_VERSION_FEATURES
@@ -111,22 +112,42 @@ def _home_of(tag: str) -> tuple[str, ...]:
     return tuple(parent for parent, (_attrs, children) in SCHEMA.items() if tag in children and parent != "robot")
 
 
-def _urdf_elements(root) -> Iterator:
+Node = tuple[Any, str, list[tuple[Any, Any]]]
+"""(element, its tag, [(child, child's tag), ...] for every child, comments included)."""
+
+
+def _children(element) -> list[tuple[Any, Any]]:
+    return [(child, child.tag) for child in element] if len(element) else []  # most are leaves: <origin/>
+
+
+def _urdf_nodes(root) -> Iterator[Node]:
     """Every element inside the robot's URDF part: <link>, <joint> and <material> children of <robot>
-    and, below them, only children the schema knows (so an extension's subtree is never walked)."""
-    stack = [child for child in root if _local(child.tag) in SCHEMA["robot"][1]]
+    and, below them, only children the schema knows (so an extension's subtree is never walked);
+    each with its children, read once for S016 and S018 (lxml makes a new object and a new tag
+    string each time a child is reached)."""
+    # ``child.tag in names`` is ``_local(child.tag) in names``: the schema's names are plain, and a
+    # comment's tag (a function) or a namespaced tag ("{uri}origin") is none of them.
+    stack = [child for child in root if child.tag in SCHEMA["robot"][1]]
     while stack:
         element = stack.pop()
-        yield element
-        children = SCHEMA[element.tag][1]
-        if element.tag == "geometry":
+        tag = element.tag
+        children = _children(element)
+        yield element, tag, children
+        if tag == "geometry":
             continue
-        stack.extend(child for child in element if _local(child.tag) in children)
+        names = SCHEMA[tag][1]
+        if names:
+            stack.extend(child for child, child_tag in children if child_tag in names)
+
+
+def _schema_nodes(ctx) -> tuple[Node, ...]:
+    """:func:`_urdf_nodes` of the file, walked once for all the schema rules."""
+    return ctx.shared("schema-nodes", lambda model: tuple(_urdf_nodes(model.root)))
 
 
 def _schema_elements(ctx) -> tuple:
-    """:func:`_urdf_elements` of the file, walked once for all the schema rules."""
-    return ctx.shared("schema-elements", lambda model: tuple(_urdf_elements(model.root)))
+    """The elements of :func:`_schema_nodes`, in the same order."""
+    return ctx.shared("schema-elements", lambda model: tuple(node[0] for node in _schema_nodes(ctx)))
 
 
 def _owner(element) -> str:
@@ -143,19 +164,22 @@ def _owner(element) -> str:
 
 def _unknown_children(ctx) -> Iterator[tuple]:
     """(element, unknown child, closest allowed name or None) for every child the schema lacks."""
-    for element in (ctx.model.root, *_schema_elements(ctx)):
-        attrs, children = SCHEMA[element.tag]
-        if element.tag in GEOMETRY_SHAPES_OWNED_ELSEWHERE:
+    root = ctx.model.root
+    for element, element_tag, element_children in ((root, root.tag, _children(root)), *_schema_nodes(ctx)):
+        attrs, children = SCHEMA[element_tag]
+        if element_tag in GEOMETRY_SHAPES_OWNED_ELSEWHERE:
             continue
-        extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[1]
-        for child in element:
-            tag = _local(child.tag)
-            if tag is None or tag in children or tag in extra:
+        extra = ENGINE_EXTENSIONS.get(element_tag, (frozenset(), frozenset()))[1]
+        for child, tag in element_children:
+            if tag in children or tag in extra:
+                continue
+            tag = _local(tag)
+            if tag is None:
                 continue
             if tag in attrs:
                 continue  # S018: an attribute written as an element
             guess = _closest(tag, children)
-            if guess is None and (element.tag == "robot" or not _home_of(tag)):
+            if guess is None and (element_tag == "robot" or not _home_of(tag)):
                 continue  # an extension (<gazebo>, <sensor>, <joint_properties>, ...), not a misspelling
             yield element, child, guess
 
@@ -207,7 +231,10 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
     for element in (ctx.model.root, *_schema_elements(ctx)):
         attrs = SCHEMA[element.tag][0]
         extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[0]
-        for name in element.attrib:
+        names = element.keys()
+        if attrs.issuperset(names):
+            continue  # every attribute is the spec's (nearly always)
+        for name in names:
             if name in attrs or name in extra or _local(name) is None:
                 continue
             guess = _closest(name, attrs)
@@ -228,11 +255,13 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
       good=arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><dynamics damping="5"/>'),
       references="Drake issue #18796 (damping as an element silently ignored); urdfdom urdf_parser/src/joint.cpp.")
 def attribute_as_element(ctx) -> Iterator[Hit]:
-    for element in _schema_elements(ctx):
-        attrs = SCHEMA[element.tag][0]
-        for child in element:
-            tag = _local(child.tag)
-            if tag is None or tag not in attrs or tag in SCHEMA[element.tag][1]:
+    for element, element_tag, element_children in _schema_nodes(ctx):
+        attrs = SCHEMA[element_tag][0]
+        if not attrs:
+            continue
+        for child, tag in element_children:
+            # the attribute names are plain: a namespaced tag or a comment is none of them
+            if tag not in attrs or tag in SCHEMA[element_tag][1]:
                 continue
             value = " ".join((child.text or "").split()) or "..."
             yield Hit(f"{_owner(element)} has <{tag}> as a child element: parsers read only the attribute "
@@ -257,20 +286,23 @@ parseInertial: "Inertial element must have a mass element", "... inertia element
       references="urdfdom urdf_parser/src/link.cpp (parseVisual, parseCollision, parseInertial); IsaacSim #599.")
 def missing_required_child(ctx) -> Iterator[Hit]:
     moving = {joint.child for joint in ctx.model.joints if joint.moves}
-    for element in _schema_elements(ctx):
-        required = REQUIRED_CHILDREN.get(element.tag)
+    for element, element_tag, element_children in _schema_nodes(ctx):
+        required = REQUIRED_CHILDREN.get(element_tag)
         if not required:
             continue
         link = element.getparent()
-        if element.tag == "inertial" and link is not None and link.get("name") in moving:
+        if element_tag == "inertial" and link is not None and link.get("name") in moving:
             continue  # I003 (mass) and I006 (inertia) report moving links
+        present = {child_tag for _child, child_tag in element_children}
         for tag in required:
-            if element.find(tag) is None:
+            if tag not in present:  # element.find(tag) is None
                 yield Hit(f"{_owner(element)} has no <{tag}>: urdfdom refuses the link, and the file", element)
 
 
 VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "deceleration": "limit", "jerk": "limit"}
 """Attribute -> element for the URDF 1.1/1.2 attributes (``<capsule>`` is G010's)."""
+VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
+"""The elements that may hold one (S020 reads only their attributes)."""
 
 
 @rule("S020", "undeclared-urdf-version", "info", "URDF 1.1/1.2 attribute in a file that does not declare it",
@@ -288,7 +320,9 @@ VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "dec
 def undeclared_urdf_version(ctx) -> Iterator[Hit]:
     model = ctx.model
     for element in _schema_elements(ctx):
-        for name in element.attrib:
+        if element.tag not in VERSION_FEATURE_HOLDERS:
+            continue
+        for name in element.keys():  # noqa: SIM118 - an lxml element: iterating it gives its children
             if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
                 yield Hit(f"{_owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "

@@ -340,7 +340,10 @@ def duplicate_element(ctx) -> Iterator[Hit]:
         for parent in ctx.model.root.iter(parent_tag):
             if parent_tag in ("joint", "link") and parent.getparent() is not ctx.model.root:
                 continue  # <joint> inside <transmission> or <ros2_control> is another element
-            counts = Counter(child.tag for child in parent if isinstance(child.tag, str))
+            tags = [child.tag for child in parent]
+            if len(set(tags)) == len(tags):
+                continue  # no tag twice (the common case): nothing to count
+            counts = Counter(tag for tag in tags if isinstance(tag, str))
             for tag in children:
                 if counts[tag] > 1:
                     extra = [child for child in parent if child.tag == tag][1]
