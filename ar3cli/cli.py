@@ -171,6 +171,12 @@ def _say(line: str) -> None:
     print(printable(line), file=sys.stderr)
 
 
+SINGLE_THREADED_BLAS = {"OPENBLAS_NUM_THREADS": "1"}
+"""Set for a command-line run (and so its child processes) unless the user set it. ar3cli's numpy
+work is small arrays (boxes, 3x3 tensors, joint samples): no matrix is large enough for OpenBLAS's
+threads to help, but starting them made ``import numpy`` cost 0.17 s of CPU instead of 0.08 s
+(``/usr/bin/time python -c "import numpy"``, 3 runs each, 2 cores), CPU that a second lint process
+or the pybullet child then lacks."""
 GC_ALLOCATIONS = 100_000
 """Allocations between two young-generation garbage collections in a command-line run (Python's
 default is 700). A cold lint of pybullet_data's 95 robots allocates a few hundred thousand
@@ -196,6 +202,8 @@ def run() -> None:
     import signal
 
     gc.set_threshold(GC_ALLOCATIONS, *gc.get_threshold()[1:])
+    for name, value in SINGLE_THREADED_BLAS.items():
+        os.environ.setdefault(name, value)
     try:
         main()
         code: int | str | None = 0

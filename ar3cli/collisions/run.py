@@ -3,7 +3,6 @@ limit configurations, count the uniform samples, classify every pair like MoveIt
 
 from __future__ import annotations
 
-import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -79,9 +78,7 @@ def sample_matrix(model: Model, samples: int, seed: int, jobs: int | None, alway
 def _count(model: Model, samples: int, seed: int, jobs: int | None, always_threshold: float) -> _Counted:
     """In the pybullet child: home and limit configurations, then the uniform samples, timed; a pair
     stops being counted once its category is decided (:mod:`ar3cli.collisions.rounds`)."""
-    # numpy is first imported here, in the child; OpenBLAS would start a thread per CPU that spins
-    # for nothing (no linear algebra is done): measured, importing numpy then takes twice the CPU
-    os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+    # numpy is first imported here, in the child, single-threaded (cli.SINGLE_THREADED_BLAS)
     from ar3cli.collisions.checker import Checker
     from ar3cli.collisions.rounds import count_in_rounds
     from ar3cli.output.progress import progress_bar
