@@ -3,6 +3,7 @@ environment, bounded work; ``--xacro trusted`` is plain xacro. Every attack is a
 
 from __future__ import annotations
 
+import json
 import math
 import os
 from pathlib import Path
@@ -76,6 +77,16 @@ def test_trusted_option_reaches_the_expansion(cli, tmp_path):
     assert "python namespace" in cli("info", str(path)).stderr
     trusted = cli("info", "--xacro", "trusted", "--format", "json", str(path))
     assert trusted.code == 0 and "n_2" in trusted.stdout
+
+
+def test_trusted_option_reaches_the_report_lint_section(cli, tmp_path):
+    """report's lint section reads the xacro as the rest of the page does: with ``--xacro trusted``
+    it is expanded, not refused (an F004 on the page for a file the page then drew)."""
+    path = _xacro(tmp_path / "robot", '<link name="n_${python.len([1, 2])}"/>')
+    page = tmp_path / "page.html"
+    result = cli("report", "--xacro", "trusted", "--samples", "1", "-o", str(page), "--format", "json", str(path))
+    assert result.code == 0, result.stderr
+    assert json.loads(result.stdout)["lint"]["error"] == 0 and "F004" not in page.read_text()
 
 
 def test_eval_substitution_runs_nothing(tmp_path):

@@ -98,7 +98,7 @@ def _pairs(sides: list[str], changed_since: str | None, package_path, xacro_arg)
     from ar3cli.lint.changed import select_changed
     from ar3cli.lint.engine import display_path
     from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
+    from ar3cli.urdf.xacro_args import parse_xacro_args
 
     try:
         packages, arguments = parse_package_paths(package_path), parse_xacro_args(xacro_arg)

@@ -69,7 +69,7 @@ def report(
                                          "described": f"{samples} samples, seed {seed}"}, "skipped": {},
                             "cross_check": None}
     lines: dict[str, list[str]] = {}
-    data["lint"], findings = lint_document(path, source.package_path, source.xacro_arg)
+    data["lint"], findings = lint_document(path, source)
     model = source.load(path)
     data["info"], lines["info"], lines["torques"] = _info(model, samples, seed, data["skipped"])
     pictures = _pictures(model, lines.setdefault("pictures", []))

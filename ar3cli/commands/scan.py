@@ -67,7 +67,7 @@ def scan(
     from ar3cli.scan.run import Backend, run_scan
     from ar3cli.scan.worker import ScanSettings
     from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
+    from ar3cli.urdf.xacro_args import parse_xacro_args
 
     if address is not None and backend is not BackendName.ray:
         raise UserError("--address joins a Ray cluster: add --backend ray")

@@ -39,7 +39,7 @@ def load_with_specs(path: Path, package_specs: list[str] | None, xacro_specs: li
     The loaders are imported here, not at start-up: every command module imports this one."""
     from ar3cli.urdf.model import load_model
     from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_expand import parse_xacro_args
+    from ar3cli.urdf.xacro_args import parse_xacro_args
 
     try:
         packages = parse_package_paths(package_specs)

@@ -30,7 +30,6 @@ from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import MAX_FILE_BYTES
 from ar3cli.output.report import log
 from ar3cli.urdf.packages import PackageResolver
-from ar3cli.urdf.xacro_args import parse_xacro_args  # noqa: F401 - its home before xacro_args.py; callers import it here
 from ar3cli.urdf.xacro_safe import ReadRoots, XacroPolicy, read_inside, safe_hooks
 
 
