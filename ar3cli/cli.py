@@ -73,12 +73,16 @@ run imports only the module of the command it runs (see :func:`application`)."""
 
 def application(argv: Sequence[str] | None = None) -> typer.Typer:
     """The app, with the command ``argv`` (default ``sys.argv[1:]``) starts with registered, or
-    every command when it starts with none (``--help``, ``--version``, a typo: click then lists or
-    suggests them all)."""
+    every command when it starts with none (``--help``, a typo: click then lists or suggests them
+    all); none for ``--version``, which its eager callback answers first (0.09 s instead of 0.24 s,
+    ``/usr/bin/time ar3cli --version``, 5 runs each)."""
     import importlib
 
     args = sys.argv[1:] if argv is None else list(argv)
-    names = [args[0]] if args and args[0] in COMMANDS else list(COMMANDS)
+    if args[:1] == ["--version"]:
+        names: list[str] = []  # answered by the eager --version callback before any command is looked up
+    else:
+        names = [args[0]] if args and args[0] in COMMANDS else list(COMMANDS)
     registered = {info.name for info in app.registered_commands}
     for name in names:
         if name not in registered:
