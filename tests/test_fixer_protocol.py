@@ -92,3 +92,20 @@ def test_fix_inertia_leaves_alone_what_the_implausible_rule_flags():
     from ar3cli.lint.rules.inertia import inertia_implausible
 
     assert {inertia_implausible.code} == IMPLAUSIBLE_CODES
+
+
+@pytest.mark.parametrize("spelling", ["optional", "union"])
+def test_an_optional_float_setting_is_finite_however_it_is_spelt(spelling):
+    """``Optional[float]`` (how the old command modules wrote it) is ``float | None``: finite too."""
+    from dataclasses import make_dataclass
+    from typing import Optional
+
+    from ar3cli.commands.fixer_options import _own_option
+    from ar3cli.commands.options import FiniteFloat
+    from ar3cli.fix.settings import setting, settings_of
+
+    annotation = Optional[float] if spelling == "optional" else float | None  # noqa: UP007 - the point of the test
+    options = make_dataclass("Options", [("effort", annotation, setting("--effort", default=None, help="N*m."))])
+    (item,) = settings_of(options)
+    info = _own_option(item).annotation.__metadata__[0]
+    assert isinstance(info.click_type, FiniteFloat)

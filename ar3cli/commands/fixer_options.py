@@ -103,5 +103,7 @@ def _own_option(item: SettingField) -> inspect.Parameter:
 
 
 def _types(annotation: Any) -> tuple[Any, ...]:
-    """``float | None`` -> ``(float, NoneType)``; a plain type -> ``(type,)``."""
-    return typing.get_args(annotation) if isinstance(annotation, types.UnionType) else (annotation,)
+    """``float | None`` (or ``Optional[float]``, a ``typing.Union``) -> ``(float, NoneType)``; a plain
+    type -> ``(type,)``."""
+    union = typing.get_origin(annotation) in (typing.Union, types.UnionType)
+    return typing.get_args(annotation) if union else (annotation,)
