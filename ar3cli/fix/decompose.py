@@ -137,7 +137,9 @@ def resolve_method(method: str) -> str:
 
 def hull_part(vertices: np.ndarray, faces: np.ndarray, factor: float) -> Part | None:
     """The convex hull of a point set as a :class:`Part`; None when it encloses no volume."""
-    import trimesh
+    from ar3cli.infra.held_import import import_holding_interrupts
+
+    trimesh = import_holding_interrupts("trimesh")
 
     try:
         hull = trimesh.Trimesh(vertices=vertices, faces=faces, process=True).convex_hull

@@ -115,7 +115,9 @@ def load_welded_mesh(path: Path):
     texture coordinate and normal); GeometryError when it cannot be read or has no triangle."""
     import io
 
-    import trimesh
+    from ar3cli.infra.held_import import import_holding_interrupts
+
+    trimesh = import_holding_interrupts("trimesh")
 
     from ar3cli.errors import UserError
     from ar3cli.urdf.meshinfo import read_mesh

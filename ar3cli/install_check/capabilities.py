@@ -132,7 +132,9 @@ def _normalise(name: str) -> str:
 
 
 def _load_mesh(path: Path):
-    import trimesh
+    from ar3cli.infra.held_import import import_holding_interrupts
+
+    trimesh = import_holding_interrupts("trimesh")
 
     return trimesh.load(str(path), force="mesh", process=True)
 

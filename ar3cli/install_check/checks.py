@@ -217,7 +217,9 @@ def run_checks(checks: list[Callable[[], Check]] | None = None) -> list[Check]:
         if result.name == "pybullet" and result.status == "ok":
             import_pybullet_here()
         if result.name == "trimesh" and result.status == "ok":
-            import trimesh  # noqa: F401 - the capability checks' children inherit it (~0.5 s each otherwise)
+            from ar3cli.infra.held_import import import_holding_interrupts
+
+            import_holding_interrupts("trimesh")  # the capability checks' children inherit it (~0.5 s each otherwise)
     return results
 
 

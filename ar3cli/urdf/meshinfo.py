@@ -305,7 +305,10 @@ def _trimesh_bounds(path: Path) -> Bounds | None:
     import io
 
     import numpy as np
-    import trimesh
+
+    from ar3cli.infra.held_import import import_holding_interrupts
+
+    trimesh = import_holding_interrupts("trimesh")
 
     loaded = trimesh.load(io.BytesIO(read_mesh(path)), file_type=path.suffix.lower().lstrip("."), force="mesh",
                           process=False)
