@@ -124,7 +124,8 @@ def _report_modules(format: str) -> None:
     """Import what the report in ``format`` needs, while the pybullet child samples: then it costs no
     wall time (measured on the panda: the report's modules, and rich's for the heat map, took ~45 ms
     after the child; rich's emoji table alone ~13 ms, loaded at the first line printed). A module
-    that is missing (rich reorganised) is simply imported later, when used, or not at all."""
+    that is missing (rich reorganised) or fails to import is imported again later, where it is used and
+    its error can be reported, or not at all: a warm-up never ends a run whose sampling went well."""
     import contextlib
     import importlib
 
@@ -132,7 +133,7 @@ def _report_modules(format: str) -> None:
     if format != "json":  # the heat map is a rich renderable: text output goes through a rich console
         modules += ["rich.console", "rich.text", "rich.table", "rich.box", "rich.padding", "rich._emoji_codes"]
     for module in modules:
-        with contextlib.suppress(ImportError):  # a warm-up only
+        with contextlib.suppress(Exception):  # a warm-up only: what fails here fails again where it is used
             importlib.import_module(module)
 
 
