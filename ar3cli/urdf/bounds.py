@@ -10,6 +10,7 @@ camera on what is drawn).
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 from ar3cli.urdf.model import rpy_rotation
 
@@ -47,13 +48,21 @@ def shape_bounds(shape, mesh_box=None) -> Box | None:
         half = tuple((b - a) / 2 for a, b in zip(low, high))  # type: ignore[assignment]
     if half is None or not all(map(math.isfinite, half)):
         return None
-    rotation = rpy_rotation(shape.origin.rpy)
+    return box_around(centre, half, rpy_rotation(shape.origin.rpy), shape.origin.xyz)
+
+
+def box_around(centre: Sequence[float], half: Sequence[float], rotation, translation: Sequence[float]) -> Box:
+    """The axis-aligned box around the box (``centre``, half-extents ``half``) rotated by ``rotation``
+    (rows) and moved by ``translation``: centred on ``R c + t``, half-extents ``|R| h``.
+
+    Shapes in their link's frame (:func:`shape_bounds`) and boxes moved along a joint chain (G014)
+    both go through it."""
     cx, cy, cz = centre
     hx, hy, hz = half
     # sum() of three-element lists: the same additions, in the same order, as sum() over the row's
     # products (a generator per row cost more than the arithmetic; the box is asked for 1,400 times
     # in a lint of pybullet_data's 95 robots)
-    world_centre = [sum([r0 * cx, r1 * cy, r2 * cz]) + t for (r0, r1, r2), t in zip(rotation, shape.origin.xyz)]
+    world_centre = [sum([r0 * cx, r1 * cy, r2 * cz]) + t for (r0, r1, r2), t in zip(rotation, translation)]
     world_half = [sum([abs(r0) * hx, abs(r1) * hy, abs(r2) * hz]) for r0, r1, r2 in rotation]
     return (tuple([c - h for c, h in zip(world_centre, world_half)]),  # type: ignore[return-value]
             tuple([c + h for c, h in zip(world_centre, world_half)]))
@@ -111,5 +120,10 @@ def link_bounds(link, shape_box=shape_bounds) -> Box | None:
     boxes = [b for b in (shape_box(s) for s in (link.collisions or link.visuals)) if b is not None]
     if not boxes or not all(all(map(math.isfinite, corner)) for box in boxes for corner in box):
         return None
+    return box_union(boxes)
+
+
+def box_union(boxes: Sequence[Box]) -> Box:
+    """The box around ``boxes`` (at least one)."""
     lows, highs = zip(*boxes)
     return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]

@@ -12,7 +12,7 @@ import math
 from collections.abc import Iterator
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
-from ar3cli.urdf.bounds import Box
+from ar3cli.urdf.bounds import Box, box_around, box_union
 
 DETACHED_FACTOR = 1.0
 """A child's box further from its parent's box than this many times the larger of the two box
@@ -37,10 +37,7 @@ AXIS_MIN = 0.1
 
 def _union(boxes) -> Box | None:
     boxes = [b for b in boxes if b is not None and all(map(math.isfinite, (*b[0], *b[1])))]
-    if not boxes:
-        return None
-    lows, highs = zip(*boxes)
-    return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]
+    return box_union(boxes) if boxes else None
 
 
 def _diagonal(box: Box) -> float:
@@ -61,11 +58,9 @@ def _gap(a: Box, b: Box) -> float:
 
 def _moved(box: Box, rotation, translation) -> Box:
     """The axis-aligned box around ``box`` rotated by ``rotation`` (rows) and moved by ``translation``."""
-    cx, cy, cz = [(lo + hi) / 2 for lo, hi in zip(*box)]
-    hx, hy, hz = [(hi - lo) / 2 for lo, hi in zip(*box)]
-    c = [sum([r0 * cx, r1 * cy, r2 * cz]) + t for (r0, r1, r2), t in zip(rotation, translation)]
-    h = [sum([abs(r0) * hx, abs(r1) * hy, abs(r2) * hz]) for r0, r1, r2 in rotation]
-    return tuple([a - b for a, b in zip(c, h)]), tuple([a + b for a, b in zip(c, h)])  # type: ignore[return-value]
+    centre = [(lo + hi) / 2 for lo, hi in zip(*box)]
+    half = [(hi - lo) / 2 for lo, hi in zip(*box)]
+    return box_around(centre, half, rotation, translation)
 
 
 def _compose(outer, inner):
