@@ -97,13 +97,9 @@ def _pairs(sides: list[str], changed_since: str | None, package_path, xacro_arg)
 
     from ar3cli.lint.changed import select_changed
     from ar3cli.lint.engine import display_path
-    from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_args import parse_xacro_args
+    from ar3cli.urdf.loading import read_specs
 
-    try:
-        packages, arguments = parse_package_paths(package_path), parse_xacro_args(xacro_arg)
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
+    packages, arguments = read_specs(package_path, xacro_arg)
     selection = select_changed([Path(side) for side in sides or ["."]], changed_since, packages, arguments)
     parts = {used for users in selection.dependents.values() for used in users}  # compared through their users
     return [(_at_ref(changed_since, path), display_path(path)) for path in selection.files

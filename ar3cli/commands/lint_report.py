@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.errors import EXIT_USAGE
 from ar3cli.output.lint_report import LintReport
 
 if TYPE_CHECKING:
@@ -39,23 +39,15 @@ def lint_document(path: Path, source: RobotSource) -> tuple[dict, list]:
     """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
     and the findings, the file read as ``source`` says (its packages, xacro arguments, ``--xacro``
     mode and ``--xacro-env``, as the rest of the page reads it)."""
-    from ar3cli.commands.options import XacroMode
     from ar3cli.findings import Severity
     from ar3cli.lint.config import load_config
     from ar3cli.lint.engine import LintOptions, lint_paths, summarize
-    from ar3cli.urdf.loading import apply_xacro_options
-    from ar3cli.urdf.packages import parse_package_paths
-    from ar3cli.urdf.xacro_args import parse_xacro_args
 
     config = load_config()
-    try:
-        options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
-                              per_file_ignores=config.per_file_ignores, severity=config.severity,
-                              package_paths=parse_package_paths(source.package_path),
-                              xacro_args=parse_xacro_args(source.xacro_arg))
-    except ValueError as exc:
-        raise UserError(str(exc)) from None
-    apply_xacro_options(source.xacro is XacroMode.trusted, source.xacro_env)
+    packages, xacro_args = source.specs()
+    options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
+                          per_file_ignores=config.per_file_ignores, severity=config.severity,
+                          package_paths=packages, xacro_args=xacro_args)
     results = lint_paths([path], options)
     summary = summarize(results, config.fail_on or Severity.ERROR)
     summary["exit_code"] = exit_code(summary)

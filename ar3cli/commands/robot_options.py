@@ -49,10 +49,16 @@ class RobotSource:
 
     def load(self, path: Path) -> Model:
         """The Model of ``path`` (xacro expanded); malformed specs and bad files raise UserError."""
-        from ar3cli.urdf.loading import load_with_specs
+        from ar3cli.urdf.model import load_model
 
-        return load_with_specs(path, self.package_path, self.xacro_arg, self.xacro is XacroMode.trusted,
-                               self.xacro_env)
+        return load_model(path, *self.specs())
+
+    def specs(self) -> tuple[dict, dict]:
+        """(packages, xacro arguments) parsed, with the xacro mode and environment names made this
+        run's policy (:func:`~ar3cli.urdf.loading.read_specs`): for readers other than :meth:`load`."""
+        from ar3cli.urdf.loading import read_specs
+
+        return read_specs(self.package_path, self.xacro_arg, self.xacro is XacroMode.trusted, self.xacro_env)
 
 
 def robot_input(function: Callable[..., None]) -> Callable[..., None]:

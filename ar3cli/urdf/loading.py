@@ -34,10 +34,18 @@ def apply_xacro_options(trusted: bool, env_names: list[str] | None) -> None:
 
 def load_with_specs(path: Path, package_specs: list[str] | None, xacro_specs: list[str] | None,
                     xacro_trusted: bool = False, xacro_env: list[str] | None = None) -> Model:
-    """Parse the package-path and xacro-argument specs and load the model; malformed specs raise
-    UserError (exit 2). ``xacro_trusted`` / ``xacro_env`` are ``--xacro trusted`` and ``--xacro-env``.
+    """Parse the package-path and xacro-argument specs and load the model (:func:`read_specs`).
     The loaders are imported here, not at start-up: every command module imports this one."""
     from ar3cli.urdf.model import load_model
+
+    return load_model(path, *read_specs(package_specs, xacro_specs, xacro_trusted, xacro_env))
+
+
+def read_specs(package_specs: list[str] | None, xacro_specs: list[str] | None, xacro_trusted: bool = False,
+               xacro_env: list[str] | None = None) -> tuple[dict, dict]:
+    """``--package-path`` and ``--xacro-arg`` specs parsed (package -> folder, name -> value), with
+    ``--xacro trusted`` / ``--xacro-env`` made this run's xacro policy; malformed specs raise
+    UserError (exit 2). Every reader of a robot file goes through it: a model, or a lint of it."""
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_args import parse_xacro_args
 
@@ -47,4 +55,4 @@ def load_with_specs(path: Path, package_specs: list[str] | None, xacro_specs: li
     except ValueError as exc:
         raise UserError(str(exc)) from None
     apply_xacro_options(xacro_trusted, xacro_env)
-    return load_model(path, packages, xacro_args)
+    return packages, xacro_args
