@@ -16,7 +16,7 @@ from __future__ import annotations
 import difflib
 import math
 from collections.abc import Callable
-from contextlib import AbstractContextManager
+from contextlib import AbstractContextManager, nullcontext
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any, Generic, TypeVar
@@ -92,11 +92,9 @@ class Fixer(Generic[Options]):
 
     def run(self, options: Options, args: FixerArgs) -> int:
         """Run this fixer with ``options`` (an instance of :attr:`options`) on ``args``; the exit code."""
-        verify = bool(getattr(options, "verify", False))
-        if self.session is None:
-            return run_fixer(self, options, args, verify=verify)
-        with self.session(options, args) as session_args:
-            return run_fixer(self, options, session_args, verify=verify)
+        session = self.session(options, args) if self.session is not None else nullcontext(args)
+        with session as session_args:
+            return run_fixer(self, options, session_args, verify=bool(getattr(options, "verify", False)))
 
 
 @dataclass(frozen=True)
