@@ -107,16 +107,7 @@ def displacements(pair: Pair, fk: ForwardKinematics, samples: int, seed: int
 
 def path_joints(model: Model, link: str) -> list[Joint]:
     """The joints from the root down to ``link`` (each link entered once, so a loop ends the walk)."""
-    path: list[Joint] = []
-    seen = {link}
-    joint = model.parent_joint(link)
-    while joint is not None:
-        path.append(joint)
-        if joint.parent is None or joint.parent in seen:
-            break
-        seen.add(joint.parent)
-        joint = model.parent_joint(joint.parent)
-    return path[::-1]
+    return list(model.joints_above(link))[::-1]
 
 
 def cause(pair: Pair, link: str) -> str:

@@ -59,13 +59,9 @@ class PassThrough:
 
 def _geometric_parent(model: Any, link: str, solid: set[str]) -> str | None:
     """The nearest ancestor of ``link`` with collision geometry, looking through links without."""
-    seen = {link}
-    joint = model.parent_joint(link)
-    while joint is not None and joint.parent and joint.parent not in seen:
-        if joint.parent in solid:
-            return joint.parent
-        seen.add(joint.parent)
-        joint = model.parent_joint(joint.parent)
+    for joint in model.joints_above(link):
+        if joint.parent and joint.parent != link and joint.parent in solid:
+            return joint.parent  # (a loop back to ``link`` is no ancestor; other links seen again had none)
     return None
 
 

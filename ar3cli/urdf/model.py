@@ -291,6 +291,19 @@ class Model:
         """The joint whose child is ``link_name`` (the first one, if the file has several)."""
         return self._joints_by_child.get(link_name)
 
+    def joints_above(self, link_name: str) -> Iterator[Joint]:
+        """The joints from ``link_name`` up to the root, nearest first: its parent joint, that joint's
+        parent link's parent joint, ... The walk ends after a joint whose parent is missing or was
+        already passed (a loop in a broken file), so it always ends."""
+        seen = {link_name}
+        joint = self.parent_joint(link_name)
+        while joint is not None:
+            yield joint
+            if joint.parent is None or joint.parent in seen:
+                return
+            seen.add(joint.parent)
+            joint = self.parent_joint(joint.parent)
+
     def child_joints(self, link_name: str) -> list[Joint]:
         return list(self._joints_by_parent.get(link_name, ()))
 
