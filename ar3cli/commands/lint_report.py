@@ -7,16 +7,11 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from ar3cli.errors import EXIT_USAGE
+from ar3cli.lint.document import exit_code as exit_code  # lint-urdf's exit code, imported from here
 from ar3cli.output.lint_report import LintReport
 
 if TYPE_CHECKING:
     from ar3cli.commands.robot_options import RobotSource
-
-
-def exit_code(summary: dict[str, Any], exit_zero: bool = False) -> int:
-    """The exit code a lint run with ``summary`` ends with (2 when a file was not checked)."""
-    return EXIT_USAGE if summary["files_not_checked"] else 1 if summary["findings_failing"] and not exit_zero else 0
 
 
 def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: bool = False, **extra: Any) -> LintReport:
@@ -24,15 +19,11 @@ def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: b
     ``options`` (``LintOptions``); ``grouped`` folds alike findings into one text row; ``extra``
     sets the remaining :class:`LintReport` fields (note, changed, fix_commands, exit_zero, wide)."""
     from ar3cli.commands.finding_context import finding_context
+    from ar3cli.lint.document import lint_json
     from ar3cli.lint.engine import group_findings
-    from ar3cli.lint.fix_hints import fixed_by
 
-    findings = [finding for result in results for finding in result.findings]
-    data = {"files": [result.to_dict() for result in results],
-            "findings": [{**finding.to_dict(), "fixed_by": fixed_by(finding.rule)} for finding in findings],
-            "summary": summary}
-    return LintReport(results, summary, data, options.rules, group=group_findings if grouped else None,
-                      context=finding_context, **extra)
+    return LintReport(results, summary, lint_json(results, summary), options.rules,
+                      group=group_findings if grouped else None, context=finding_context, **extra)
 
 
 def lint_document(path: Path, source: RobotSource) -> tuple[dict, list]:

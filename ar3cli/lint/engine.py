@@ -228,19 +228,23 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
-        finding = load_failure(path, shown, exc.message)
+        return unloaded_result(load_failure(path, shown, exc.message), options)
     except RecursionError:
-        finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
-    else:
-        result = lint_model(model, shown, rules, options)
-        if cache is not None and not model.is_xacro:
-            cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
-        return result
-    # A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
-    # always reports syntax errors); only an explicit ignore hides it.
-    if matches(finding.rule, options.ignore) or _file_ignored(shown, finding.rule, options):
-        return LintResult(shown, False, [])
-    return LintResult(shown, False, [_override(finding, options)])
+        return unloaded_result(Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown), options)
+    result = lint_model(model, shown, rules, options)
+    if cache is not None and not model.is_xacro:
+        cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
+    return result
+
+
+def unloaded_result(finding: Finding, options: LintOptions) -> LintResult:
+    """The result of a file that did not load, ``finding`` (:func:`load_failure`) saying why.
+
+    A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
+    always reports syntax errors); only an explicit ignore hides it."""
+    if matches(finding.rule, options.ignore) or _file_ignored(finding.path, finding.rule, options):
+        return LintResult(finding.path, False, [])
+    return LintResult(finding.path, False, [_override(finding, options)])
 
 
 def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
