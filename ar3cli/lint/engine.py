@@ -277,12 +277,13 @@ def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
     list, not once per file (a bulk lint hands every file the same list)."""
     global _PARTITIONED
     given = tuple(rules)
-    if _PARTITIONED is None or _PARTITIONED[0] != given:  # the same rules: an identity check each
+    known = _PARTITIONED  # read once: another thread (an editor's server) may replace it meanwhile
+    if known is None or known[0] != given:  # the same rules: an identity check each
         static = [rule for rule in given if not rule.needs_sim and rule.check is not None]
         simulated = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
         in_mujoco = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
-        _PARTITIONED = (given, (static, simulated, in_mujoco))
-    return _PARTITIONED[1]
+        known = _PARTITIONED = (given, (static, simulated, in_mujoco))
+    return known[1]
 
 
 _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
@@ -450,9 +451,10 @@ def suppressed_inline(element, code: str) -> bool:
     """
     global _LAST_IGNORES
     root = element.getroottree().getroot()
-    if _LAST_IGNORES is None or _LAST_IGNORES.root is not root:
-        _LAST_IGNORES = InlineIgnores(root)
-    return _LAST_IGNORES.suppresses(element, code)
+    known = _LAST_IGNORES  # read once: another thread may be linting another tree
+    if known is None or known.root is not root:
+        known = _LAST_IGNORES = InlineIgnores(root)
+    return known.suppresses(element, code)
 
 
 class InlineIgnores:

@@ -19,10 +19,12 @@ xacro alone writes. :func:`origins` gives the linter each element's origin, in d
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import io
 import os
 import re
+import weakref
 from pathlib import Path
 from typing import NamedTuple
 
@@ -45,15 +47,35 @@ class Origin(NamedTuple):
 ORIGIN_ATTRIBUTE = "ar3cli-origin"
 """The attribute that carries an element's origin through xacro (taken off before the output)."""
 _KEEP_ORIGINS = 4
-"""Expansions whose origins are kept: a file is linted right after it is expanded."""
-_origins: dict[bytes, tuple[list[Origin | None], list[str]]] = {}
+"""Expansions whose origins are kept in any case: a file is linted right after it is expanded."""
+
+
+class Expansion:
+    """What an expansion knows beyond its URDF: each element's origin and the files xacro read.
+    A :class:`~ar3cli.urdf.model.Model` holds its own (``Model.expansion``), so :func:`origins`
+    answers for every model still in use (an editor's open files), not only the last few."""
+
+    __slots__ = ("found", "included", "__weakref__")
+
+    def __init__(self, found: list[Origin | None], included: list[str]) -> None:
+        self.found = found
+        self.included = included
+
+
+_origins: weakref.WeakValueDictionary[bytes, Expansion] = weakref.WeakValueDictionary()
+_recent: collections.deque[Expansion] = collections.deque(maxlen=_KEEP_ORIGINS)
+
+
+def expansion_of(xml_bytes: bytes) -> Expansion | None:
+    """The :class:`Expansion` of bytes :func:`expand` returned (None for other bytes)."""
+    return _origins.get(xml_bytes)
 
 
 def origins(xml_bytes: bytes) -> list[Origin | None] | None:
     """The origin of each element of an expansion :func:`expand` returned, in document order
     (None for an element xacro made itself, such as ``xacro:element``); None for other bytes."""
     kept = _origins.get(xml_bytes)
-    return kept[0] if kept is not None else None
+    return kept.found if kept is not None else None
 
 
 def set_policy(policy: XacroPolicy) -> None:
@@ -116,16 +138,16 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver, source: 
         raise UserError(f"{path}: xacro error: the expansion died ({exc.signal_name})") from None
     for line in result.notes:
         log(f"ar3cli: note: {path}: xacro says: {line}")
-    while len(_origins) >= _KEEP_ORIGINS:
-        del _origins[next(iter(_origins))]
-    _origins[result.data] = (result.found, result.included)
+    kept = Expansion(result.found, result.included)
+    _origins[result.data] = kept
+    _recent.append(kept)
     return result.data
 
 
 def included_files(xml_bytes: bytes) -> list[str]:
     """The files xacro read (includes, YAML) for an expansion :func:`expand` returned, as xacro named them."""
     kept = _origins.get(xml_bytes)
-    return list(kept[1]) if kept is not None else []
+    return list(kept.included) if kept is not None else []
 
 
 def _limit_this_process() -> None:
