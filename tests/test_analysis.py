@@ -267,7 +267,7 @@ def test_the_verdict_is_built_from_every_section(tmp_path):
     assert "P002" in {f.rule for f in findings.findings(analysis).findings}
     assert checks["renders"].status is verdict.Status.WARNING and checks["renders"].count == 1
     assert checks["collisions"].status is verdict.Status.WARNING
-    assert checks["collisions"].line.startswith("1 pair in contact at home; of 6 pairs: 1 default")
+    assert checks["collisions"].line.startswith("1 pair in contact at home; of 6 pairs: 3 adjacent, 1 default")
     assert checks["fk"].status is verdict.Status.PASS
     assert result.status is not verdict.Status.PASS
     assert result.headline.startswith(result.status.value.upper() + ": ")
@@ -285,3 +285,16 @@ def test_xacro_findings_keep_their_lines_however_many_files_were_expanded_since(
     lines = {(f.path, f.line) for f in findings.static_findings(first).findings}
     assert any(path.endswith("macros/arm_segment.xacro") for path, _ in lines)
     assert lines == {(f.path, f.line) for f in findings.static_findings(others[0]).findings}
+
+
+def test_a_check_that_cannot_run_is_not_checked_with_its_reason(tmp_path):
+    """A robot without geometry: no picture, no collision matrix; those checks say why (without the
+    file's path in front), and nothing counts as passed."""
+    robot = tmp_path / "bare.urdf"
+    robot.write_text(f'<robot name="bare"><link name="a">{INERTIAL}</link></robot>', encoding="utf-8")
+    checks = {check.key: check for check in verdict.verdict(RobotAnalysis.load(robot)).checks}
+    for key in ("renders", "collisions"):
+        assert checks[key].status is verdict.Status.NOT_CHECKED, key
+        assert not checks[key].line.startswith(str(robot)), checks[key].line
+    assert "no link has <collision>" in checks["collisions"].line
+    assert verdict.without_path(f"{robot}:12: bad", robot) == "line 12: bad"

@@ -25,7 +25,9 @@ The questions, one module each (every question is ``function(analysis, *args)``)
 - :mod:`~ar3cli.analysis.collisions`: ``collision_matrix`` (sample-collisions);
 - :mod:`~ar3cli.analysis.kinematics`: ``fk_verify``;
 - :mod:`~ar3cli.analysis.cross_check`: ``cross_check`` (PyBullet against MuJoCo; None without the extra);
-- :mod:`~ar3cli.analysis.verdict`: ``verdict``, one status built from every section's :class:`Check`;
+- :mod:`~ar3cli.analysis.verdict`: ``verdict``, one status built from every section's ``Check``
+  (a check is ``@check(key, title)`` on a function returning an ``Outcome``; ``verdict(analysis,
+  checks)`` takes any tuple of them, so a front-end adds its own without editing the module);
 - :mod:`~ar3cli.analysis.report`: ``robot_report``, everything ``ar3cli report``'s page shows.
 
 Adding a question is adding a module here (or a function in one), nothing else::

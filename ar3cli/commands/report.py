@@ -13,6 +13,7 @@ from typing import Annotated
 
 import typer
 
+from ar3cli.commands.lint_options import TargetOption, parse_targets
 from ar3cli.commands.options import (
     FollowSymlinksOption,
     FormatOption,
@@ -40,16 +41,20 @@ def report(
     samples: SamplesOption = 100,
     seed: SeedOption = 0,
     follow_symlinks: FollowSymlinksOption = False,
+    target: TargetOption = None,
     format: FormatOption = "text",
     timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
-    """Write one self-contained HTML page about a robot: summary, kinematic tree, pictures from three
-    sides (visual and collision, contacts at home in red), lint findings with their source lines
-    and fix commands, the self-collision heat map, torque margins and fk-verify's verdict.
+    """Write one self-contained HTML page about a robot: one verdict built from every section, then
+    each section collapsed to its own verdict and count: summary, kinematic tree, pictures from three
+    sides (visual and collision, contacts at home in red), lint findings (static and PyBullet rules,
+    as lint-urdf --sim) with their source lines and fix commands, the self-collision heat map,
+    torque margins, fk-verify and cross-check.
 
     The page works offline and loads nothing (inline CSS, JS and pictures). Its data island holds the
-    JSON documents of info --torques, lint-urdf, sample-collisions and fk-verify for the same
-    --samples and --seed.
+    JSON documents of info --torques, lint-urdf --sim, sample-collisions, fk-verify and cross-check
+    for the same --samples and --seed, and the verdict. Exit 0 once the page is written, whatever
+    the verdict (use lint-urdf as a gate).
     """
     from ar3cli.analysis.report import robot_report
     from ar3cli.analysis.robot import RobotAnalysis
@@ -61,14 +66,16 @@ def report(
 
     output = check_writable(output, follow_symlinks)
     packages, xacro_args = source.specs()
-    settings = AnalysisSettings(packages=packages, xacro_args=xacro_args, config=load_config(), samples=samples,
-                                seed=seed)
+    settings = AnalysisSettings(packages=packages, xacro_args=xacro_args, config=load_config(),
+                                targets=parse_targets(target) if target else None, samples=samples, seed=seed)
     made = robot_report(RobotAnalysis.load(path, settings))
     document = robot_page(made.data, {"lines": made.lines, **finding_context(made.findings)},
                           made.pictures).encode("utf-8")
     atomic_write(output, document)
-    summary, skipped = made.data["lint"]["summary"], made.data["skipped"]
-    finish(Report(data={"path": str(output), "bytes": len(document), "lint": summary, "skipped": skipped},
-                  lines=[f"wrote {output} ({len(document) / 1024:.0f} KB): {summary['error']} errors, "
-                         f"{summary['warning']} warnings, {summary['info']} info"]
-                  + [f"not on the page: {key}: {why}" for key, why in skipped.items()]), format)
+    summary, skipped, verdict = made.data["lint"]["summary"], made.data["skipped"], made.data["verdict"]
+    finish(Report(data={"path": str(output), "bytes": len(document), "verdict": verdict, "lint": summary,
+                        "skipped": skipped},
+                  lines=[f"wrote {output} ({len(document) / 1024:.0f} KB): {verdict['headline']}"]
+                  + [f"{check['title']}: {check['status']}: {check['line']}" for check in verdict["checks"]
+                     if check["status"] != "pass"]
+                  + [f"note: {note}" for note in verdict["notes"]]), format)
