@@ -21,7 +21,8 @@ import pytest
 
 from tests.conftest import ASSETS, REPO, run_cli
 
-AR3 = ASSETS / "ar3" / "ar3.urdf"
+AR3 = (ASSETS / "ar3" / "ar3.urdf").relative_to(REPO)
+"""Relative to the repository (run_cli's folder): the page's header names no machine path (README's picture)."""
 SAMPLES = "12"
 SEED = "3"
 EVIL = "<script>alert(1)</script>"
@@ -42,7 +43,7 @@ EVIL_URDF = """<?xml version="1.0"?>
     <collision><origin xyz="0 0 0.1"/><geometry><box size="0.05 0.05 0.2"/></geometry></collision>
     <visual><origin xyz="0 0 0.1"/><geometry><box size="0.05 0.05 0.2"/></geometry></visual></link>
   <joint name="j1" type="revolute"><parent link="base"/><child link="&lt;script&gt;alert(1)&lt;/script&gt;"/>
-    <origin xyz="0 0 0.05"/><axis xyz="0 1 0"/><limit lower="-1" upper="1" effort="5" velocity="1"/></joint>
+    <origin xyz="0 0 0.05"/><axis xyz="0 1 0"/><limit lower="0.2" upper="1" effort="5" velocity="1"/></joint>
   <joint name="j2" type="revolute"><parent link="&lt;script&gt;alert(1)&lt;/script&gt;"/><child link="tip&quot;'&amp;"/>
     <origin xyz="0 0 0.6"/><axis xyz="0 1 0"/><limit lower="-2" upper="2" effort="0.1" velocity="1"/></joint>
 </robot>
@@ -105,12 +106,12 @@ def test_robot_strings_are_escaped(pages):
 
 
 def test_numbers_equal_the_json_outputs(pages):
-    """The island holds what info, lint-urdf, sample-collisions, fk-verify and (MuJoCo installed) cross-check
-    print with --format json."""
+    """The island holds what info, lint-urdf --sim, sample-collisions, fk-verify and (MuJoCo installed)
+    cross-check print with --format json."""
     island = _island(pages["ar3"].read_text(encoding="utf-8"))
     common = ("--samples", SAMPLES, "--seed", SEED)
     assert island["info"] == _json("info", str(AR3), "--torques", *common)
-    lint = _json("lint-urdf", str(AR3))
+    lint = _json("lint-urdf", "--sim", str(AR3))
     assert island["lint"]["summary"] == lint["summary"] and island["lint"]["findings"] == lint["findings"]
     collisions = _json("sample-collisions", str(AR3), *common)
     timing = ("elapsed_s", "configs_per_second", "jobs")
@@ -123,6 +124,41 @@ def test_numbers_equal_the_json_outputs(pages):
         cross = _json("cross-check", str(AR3), *common)
         assert {k: v for k, v in island["cross_check"].items() if k not in ("passed", "lines")} == cross
         assert island["cross_check"]["passed"] is cross["agree"]
+
+
+def test_one_verdict_at_the_top_built_from_every_section(pages):
+    """The verdict comes first and is the worst status of the sections' checks; each section is
+    collapsed to its own status, which is its check's; the findings include the PyBullet rules; no
+    card says "lint passed" while a section warns."""
+    page = pages["evil"].read_text(encoding="utf-8")
+    island = _island(page)
+    verdict = island["verdict"]
+    statuses = {check["key"]: check["status"] for check in verdict["checks"]}
+    assert set(statuses) == {"findings", "renders", "collisions", "torques", "fk", "cross-check"}
+    assert statuses["torques"] == "warning"  # j2 cannot hold the tip up
+    rank = {"fail": 2, "warning": 1}
+    worst = max(rank.get(status, 0) for status in statuses.values())
+    assert verdict["status"] == {2: "fail", 1: "warning", 0: "pass"}[worst]
+    assert verdict["headline"].startswith(verdict["status"].upper() + ": ")
+    assert page.index('id="verdict"') < page.index("<nav>") < page.index('id="summary"')
+    assert f'data-verdict="{verdict["status"]}"' in page
+    for key, status in statuses.items():
+        assert re.search(rf'<details class="section" id="{re.escape(key)}" data-status="{status}">', page), key
+    assert island["lint"]["summary"]["info"] + island["lint"]["summary"]["warning"] > 0
+    assert {f["rule"][0] for f in island["lint"]["findings"]} >= {"P"}, "the PyBullet rules ran"
+    assert "lint</b>" not in page and ">passed<" not in page
+
+
+def test_the_page_says_the_home_pose_is_not_all_zeros(pages):
+    """j1's range is [0.2, 1]: the pictures show it at 0.6, and the page says so at the top and above them."""
+    page = pages["evil"].read_text(encoding="utf-8")
+    island = _island(page)
+    assert island["home"]["away_from_zero"] == {"j1": "0 is outside [0.2, 1]"}
+    assert island["home"]["values"]["j1"] == pytest.approx(0.6)
+    assert any(note.startswith("home pose is not all zeros: j1 = 0.6") for note in island["verdict"]["notes"])
+    assert 'data-home="moved"' in page
+    assert all(render["configuration"]["j1"] == pytest.approx(0.6) for render in island["renders"])
+    assert 'data-home="zero"' in pages["ar3"].read_text(encoding="utf-8")
 
 
 def test_findings_carry_source_lines_and_fixes(pages):
@@ -172,12 +208,14 @@ class _Counts(html.parser.HTMLParser):
         super().__init__()
         self.counts: dict[str, int] = {}
         self.loaded: str | None = None
+        self.verdict: str | None = None
         self._key: str | None = None
 
     def handle_starttag(self, tag, attrs):
         attributes = dict(attrs)
         if tag == "html":
             self.loaded = attributes.get("data-loaded")
+        self.verdict = attributes.get("data-verdict", self.verdict)
         self._key = attributes.get("data-count")
 
     def handle_data(self, data):
@@ -207,7 +245,11 @@ def test_chromium_renders_the_page(pages, name, tmp_path):
         colours = image.convert("RGB").getcolors(maxcolors=1 << 16)
         assert colours is None or len(colours) > 50, "the screenshot is blank"
         if name == "ar3" and os.environ.get("AR3CLI_REPORT_SCREENSHOT"):
-            image.crop((0, 0, 1200, 1400)).save(REPO / os.environ["AR3CLI_REPORT_SCREENSHOT"], optimize=True)
+            from PIL import ImageChops
+
+            content = ImageChops.difference(image.convert("RGB"), Image.new("RGB", image.size, "white")).getbbox()
+            bottom = min(1400, (content[3] if content else 1400) + 16)
+            image.crop((0, 0, 1200, bottom)).save(REPO / os.environ["AR3CLI_REPORT_SCREENSHOT"], optimize=True)
     dom = _chromium(pages[name], "--dump-dom", profile=tmp_path / "profile")
     parser = _Counts()
     parser.feed(dom.stdout)
@@ -215,3 +257,72 @@ def test_chromium_renders_the_page(pages, name, tmp_path):
     summary = island["summary"] if name == "lint" else island["lint"]["summary"]
     assert parser.loaded is not None, "the page's script did not run"
     assert parser.counts == {key: summary[key] for key in ("error", "warning", "info", "findings")}
+    if name != "lint":
+        assert parser.verdict == island["verdict"]["status"]
+
+
+def _plain_page(**data) -> str:
+    """robot_page on hand-made data (no pybullet): the renderer alone."""
+    from ar3cli.output.html import robot_page
+
+    return robot_page({"info": {"name": "r"}, "lint": {"summary": {}}, **data}, {"lines": data.pop("lines", {})}, [])
+
+
+def test_collision_warnings_are_grouped_by_kind():
+    """G1 at 100 samples: ~60 'contact only at a joint limit' infos opened the section as 60 bullets;
+    now one line per kind (warnings first) with the count, the pairs one click away."""
+    warnings = [{"rule": "contact-only-at-limits", "severity": "info", "message": f"a{n} - b{n} never collided ...",
+                 "hint": None} for n in range(60)]
+    warnings.append({"rule": "contact-at-home", "severity": "warning", "message": "x - y are in contact",
+                     "hint": "usually a modelling error"})
+    collisions = {"links": ["x", "y"], "samples": 100, "pairs": [], "warnings": warnings}
+    page = _plain_page(collisions=collisions, lines={"collisions": ["seed 0: 100 uniform samples"]})
+    groups = re.findall(r'<details class="group" data-rule="([^"]+)" data-group-count="(\d+)">', page)
+    assert groups == [("contact-at-home", "1"), ("contact-only-at-limits", "60")]
+    assert "60 pairs touching only at a joint limit" in page and "1 pair in contact at the home pose" in page
+    shown = page.split('id="data"')[0]
+    assert shown.count("never collided") == 60 and "<li>info:" not in shown
+
+
+def test_the_heat_map_has_the_png_s_colours_and_letters():
+    """The page's matrix and sample-collisions --png colour a pair alike (one palette)."""
+    from ar3cli.collisions import heatmap_png
+    from ar3cli.output.collision_palette import hex_colour
+    from ar3cli.output.html_charts import heat_map_svg
+
+    pairs = [{"link_a": "a", "link_b": "b", "category": "adjacent", "sampled": False, "fraction": 0.0, "collisions": 0},
+             {"link_a": "a", "link_b": "c", "category": "default", "sampled": True, "fraction": 1.0, "collisions": 0,
+              "at_home": True},
+             {"link_a": "b", "link_b": "c", "category": "sometimes", "sampled": True, "fraction": 0.1, "collisions": 7},
+             {"link_a": "a", "link_b": "d", "category": "never", "sampled": True, "fraction": 0.0, "collisions": 0},
+             {"link_a": "b", "link_b": "d", "category": "always", "sampled": True, "fraction": 0.99, "collisions": 99}]
+    svg = heat_map_svg({"links": ["a", "b", "c", "d"], "samples": 100, "pairs": pairs})
+    fills = dict(re.findall(r'fill="(#[0-9a-f]{6})"[^>]*data-category="(\w+)"', svg))
+    fills = {category: fill for fill, category in fills.items()}
+    for category in ("adjacent", "default", "never", "always"):
+        assert fills[category] == hex_colour(heatmap_png.CATEGORY_COLOURS[category]), category
+    assert fills["sometimes"] == hex_colour(heatmap_png.ramp_colour(heatmap_png.scale_position(0.1)))
+    letters = re.findall(r'pointer-events="none">([^<]+)</text>', svg)
+    assert sorted(letters) == ["7", "A", "D", "X"]
+
+
+def test_fk_s_worst_link_names_only_the_joints_that_move_it(tmp_path):
+    """fk-verify's line named every joint of the robot (43 on G1); the page names the worst link's
+    chain from the root (at most 8) and says how many other joints there are."""
+    from ar3cli.analysis.report import fk_lines
+    from ar3cli.urdf.model import load_model
+
+    links = "".join(f'<link name="l{n}"/><link name="b{n}"/>' for n in range(12))
+    chain = "".join(f'<joint name="j{n}" type="revolute"><parent link="l{n - 1}"/><child link="l{n}"/>'
+                    '<limit lower="-1" upper="1" effort="1" velocity="1"/></joint>' for n in range(1, 12))
+    branch = "".join(f'<joint name="k{n}" type="revolute"><parent link="{"l0" if n == 0 else f"b{n - 1}"}"/>'
+                     f'<child link="b{n}"/><limit lower="-1" upper="1" effort="1" velocity="1"/></joint>'
+                     for n in range(12))
+    robot = tmp_path / "long.urdf"
+    robot.write_text(f'<robot name="long">{links}{chain}{branch}</robot>', encoding="utf-8")
+    configuration = {f"j{n}": 0.5 for n in range(1, 12)} | {f"k{n}": -0.25 for n in range(12)}
+    lines = fk_lines(load_model(robot), {"worst": {"link": "l11", "sample": 4, "configuration": configuration},
+                                         "notes": ["a note"]})
+    assert lines[0] == "note: a note"
+    assert lines[1] == ("worst link: l11 (sample 4): " + ", ".join(f"j{n}=0.5" for n in range(1, 9))
+                        + " and 3 more; 12 other joints are not on its path to the root")

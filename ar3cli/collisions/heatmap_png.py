@@ -1,74 +1,49 @@
 """The self-collision pair matrix as a picture (PNG), for READMEs, reviews and CI artifacts.
 
 Lower triangle, one cell per pair of links with collision geometry, the link names on both axes
-(rows on the left, columns underneath). Each of MoveIt's categories has its colour and, but for
-``never``, the letter the terminal heat map uses (:func:`ar3cli.collisions.matrix.heat_map`), so the
-categories stay apart in greyscale too: adjacent grey-blue ``A``, default red ``D`` (in contact at
-home), always magenta ``X``, never pale green (empty). A ``sometimes`` cell is coloured on a
-logarithmic yellow-orange-brown scale by the fraction of samples in collision (0.1% and below the
-palest, 100% the darkest) and holds the count of colliding samples when it fits in the cell; a pair
-that touched only at a joint limit (no sample) is pale yellow with ``L``. Under the matrix, the
-legend: one swatch per category and the colour scale with its numbers. Drawn with Pillow.
+(rows on the left, columns underneath), in the colours and letters of
+:mod:`ar3cli.output.collision_palette` (the report page's heat map uses the same); a ``sometimes``
+cell holds the count of colliding samples when it fits in the cell. Under the matrix, the legend:
+one swatch per category and the colour scale with its numbers. Drawn with Pillow.
 """
 
 from __future__ import annotations
 
 import io
-import math
 from collections.abc import Sequence
 from typing import Any
 
 from ar3cli.collisions.matrix import PairResult
+from ar3cli.output.collision_palette import (
+    CATEGORY_COLOURS,
+    CATEGORY_LETTERS,
+    LEGEND,
+    LIMIT_ONLY,
+    RAMP,
+    SCALE_LOW,
+    SCALE_TICKS,
+    SCALE_TITLE,
+    ink,
+    pair_colour,
+    pair_letter,
+    ramp_colour,
+    scale_position,
+)
 
 CELL = 36
 MARGIN = 12
-CATEGORY_COLOURS = {
-    "adjacent": (120, 144, 180),
-    "default": (214, 48, 49),
-    "always": (170, 60, 170),
-    "never": (214, 240, 214),
-}
-CATEGORY_LETTERS = {"adjacent": "A", "default": "D", "always": "X", "never": ""}
-LIMIT_ONLY = "L"
-RAMP = ((255, 240, 160), (245, 150, 40), (140, 45, 15))
-"""The 'sometimes' scale: pale yellow at SCALE_LOW and below, orange half-way (log), brown at 100%."""
-SCALE_LOW = 0.001
-"""The fraction at the pale end of the scale: most 'sometimes' pairs collide in 0.1% to 10% of samples."""
-SCALE_TICKS = (0.001, 0.01, 0.1, 1.0)
 BAR_WIDTH = 240
 BAR_HEIGHT = 14
-LEGEND = [("adjacent", "adjacent (joined by a joint)"), ("default", "default (in contact at home)"),
-          ("always", "always (in contact in nearly every sample)"), ("never", "never (no contact seen)")]
-
-
-def scale_position(fraction: float) -> float:
-    """0..1 along the colour scale: log10 from :data:`SCALE_LOW` (0) to 1.0 (1), clipped."""
-    if fraction <= SCALE_LOW:
-        return 0.0
-    return min(1.0, math.log10(fraction / SCALE_LOW) / -math.log10(SCALE_LOW))
-
-
-def ramp_colour(t: float) -> tuple[int, int, int]:
-    """The colour at position ``t`` (0..1) of :data:`RAMP`."""
-    t = min(1.0, max(0.0, t))
-    segment = min(int(t * (len(RAMP) - 1)), len(RAMP) - 2)
-    local = t * (len(RAMP) - 1) - segment
-    low, high = RAMP[segment], RAMP[segment + 1]
-    return tuple(round(a + (b - a) * local) for a, b in zip(low, high))  # type: ignore[return-value]
 
 
 def cell_colour(result: PairResult) -> tuple[int, int, int]:
     """The fill of one pair's cell: its category's colour, or the scale colour of its fraction for 'sometimes'."""
-    if result.category != "sometimes":
-        return CATEGORY_COLOURS[result.category]
-    return ramp_colour(scale_position(result.fraction))
+    return pair_colour(result.category, result.fraction)
 
 
 def cell_text(result: PairResult) -> str:
     """What a cell says: the category letter, the count of colliding samples, or L (limits only)."""
-    if result.category != "sometimes":
-        return CATEGORY_LETTERS[result.category]
-    return str(result.collisions) if result.collisions else LIMIT_ONLY
+    return pair_letter(result.category, result.collisions)
 
 
 def heat_map_png(links: Sequence[str], pairs: Sequence[tuple[int, int]], results: Sequence[PairResult],
@@ -94,7 +69,7 @@ def heat_map_image(links: Sequence[str], pairs: Sequence[tuple[int, int]], resul
     top = MARGIN + (24 if title else 0)
     count = max(len(links) - 1, 1)
     grid = CELL * count
-    scale_title = "sometimes: fraction of samples in collision (log scale); a cell holds the count"
+    scale_title = SCALE_TITLE
     legend_width = max(probe.textlength(scale_title, font=small),
                        max(probe.textlength(text, font=font) for _, text in LEGEND) + 26,
                        BAR_WIDTH + probe.textlength(f"{LIMIT_ONLY}  only at a joint limit", font=font) + 40)
@@ -122,7 +97,7 @@ def heat_map_image(links: Sequence[str], pairs: Sequence[tuple[int, int]], resul
             text = cell_text(result)
             chosen = font if len(text) <= 2 else small
             if text and probe.textlength(text, font=chosen) <= CELL - 6:
-                draw.text((x + CELL / 2 - 1, y + CELL / 2 - 1), text, fill=_ink(fill), font=chosen, anchor="mm")
+                draw.text((x + CELL / 2 - 1, y + CELL / 2 - 1), text, fill=ink(fill), font=chosen, anchor="mm")
     columns = Image.new("RGB", (int(label_width), grid), "white")
     column_draw = ImageDraw.Draw(columns)
     for column in range(len(links) - 1):
@@ -135,7 +110,7 @@ def heat_map_image(links: Sequence[str], pairs: Sequence[tuple[int, int]], resul
         draw.rectangle((MARGIN, y, MARGIN + 16, y + 16), fill=colour)
         letter = CATEGORY_LETTERS[category]
         if letter:
-            draw.text((MARGIN + 8, y + 8), letter, fill=_ink(colour), font=small, anchor="mm")
+            draw.text((MARGIN + 8, y + 8), letter, fill=ink(colour), font=small, anchor="mm")
         draw.text((MARGIN + 24, y + 8), text, fill="black", font=font, anchor="lm")
         y += 20
     draw.text((MARGIN, scale_top), scale_title, fill="black", font=small)
@@ -157,12 +132,6 @@ def heat_map_image(links: Sequence[str], pairs: Sequence[tuple[int, int]], resul
              "legend": (MARGIN, legend_top, width - MARGIN, height - MARGIN),
              "scale": (MARGIN, bar_top, MARGIN + BAR_WIDTH, bar_top + BAR_HEIGHT)}
     return image, boxes
-
-
-def _ink(fill: tuple[int, int, int]) -> str:
-    """Black on light fills, white on dark ones."""
-    luminance = 0.299 * fill[0] + 0.587 * fill[1] + 0.114 * fill[2]
-    return "black" if luminance > 140 else "white"
 
 
 def _font(image_font, size: int):

@@ -38,6 +38,9 @@ __all__ = ["classify", "findings", "pybullet_filter_bytes"]
 CATEGORIES = ("adjacent", "default", "always", "never", "sometimes")
 DISABLED = ("adjacent", "default", "always", "never")
 SRDF_REASONS = {"adjacent": "Adjacent", "default": "Default", "always": "Always", "never": "Never"}
+ALWAYS_THRESHOLD = 0.95
+"""The default share of samples in contact that makes a pair ``always`` (sample-collisions'
+``--always-threshold``, MoveIt Setup Assistant's 95%)."""
 Z_95 = 1.959963984540054
 ADJACENT_MIN_SAMPLES = 50
 """An adjacent pair is counted over at least this many samples (or all of them) before it is retired:

@@ -21,7 +21,6 @@ from ar3cli.output.formats import finish
 SamplesOption = Annotated[int, samples_option("Random configurations to compare.", most=1_000_000)]
 DhOption = Annotated[Optional[Path], typer.Option("--dh", metavar="DH.yaml",
                                                   help="A DH table to check against the URDF (see docs).")]
-DEFAULT_TOLERANCE_M = 1e-6
 ToleranceMOption = Annotated[Optional[float], typer.Option(
     "--tolerance-m", show_default=False, click_type=finite_float(),
     help="Largest position error that passes (m). Default: 1e-6 m, raised far from the origin to 4 float32 epsilons "
@@ -51,7 +50,7 @@ def fk_verify(
     degrees read as radians, the first wrong row). Exit 1 when any error exceeds the tolerance.
     """
     from ar3cli.kinematics import dh as dh_module
-    from ar3cli.kinematics.verify import Tolerance, check_dh, fk_report, measure
+    from ar3cli.kinematics.verify import DEFAULT_TOLERANCE_M, Tolerance, check_dh, fk_report, measure
 
     if not ((tolerance_m is None or tolerance_m > 0) and tolerance_rad > 0):
         raise UserError("--tolerance-m and --tolerance-rad must be positive")

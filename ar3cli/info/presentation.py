@@ -102,7 +102,7 @@ def kinematic_tree(summary: Summary) -> Any:
             for joint in children.get(link, []):
                 child = joint.child or "?"
                 loop = child in seen
-                branch = node.add(Text(f"{child}  ({_joint_label(joint)})" + ("  [loop]" if loop else "")))
+                branch = node.add(Text(f"{child}  ({joint_label(joint)})" + ("  [loop]" if loop else "")))
                 if not loop:
                     seen.add(child)
                     branches.append((branch, child))
@@ -186,7 +186,9 @@ def _mesh_line(summary: Summary) -> str:
     return line
 
 
-def _joint_label(joint: JointInfo) -> str:
+def joint_label(joint: JointInfo) -> str:
+    """``name: type, axis X Y Z, LOWER .. UPPER unit, follows LEADER``: one joint in one line (the
+    tree's edges, an editor's hover)."""
     parts = [f"{joint.name}: {joint.type}"]
     if joint.axis is not None and joint.type != "fixed":
         parts.append(f"axis {_axis(joint)}")

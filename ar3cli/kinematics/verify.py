@@ -24,6 +24,10 @@ base with prismatic x/y joints of +-20 m and a two-link arm (tests/test_fk_verif
 0.5 epsilon x reach (1.3e-6 m at 22 m); Fetch, a mobile Panda and a Dingo-Kinova show 1.1-2.4e-6 m at
 10-20 m. 4 epsilons leave room for rounding that accumulates along a chain while a 0.1 mm mistake at
 20 m still fails (the allowance there is 9.5e-6 m)."""
+DEFAULT_TOLERANCE_M = 1e-6
+"""fk-verify's position tolerance (m) when none is given: scaled with the reach (:class:`Tolerance`)."""
+DEFAULT_TOLERANCE_RAD = 1e-6
+"""fk-verify's orientation tolerance (rad, geodesic) when none is given (its --tolerance-rad default)."""
 ERROR_COLUMNS = ["max position (m)", "mean position (m)", "max orientation (rad)", "mean orientation (rad)"]
 
 

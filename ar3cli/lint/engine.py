@@ -228,19 +228,23 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
-        finding = load_failure(path, shown, exc.message)
+        return unloaded_result(load_failure(path, shown, exc.message), options)
     except RecursionError:
-        finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
-    else:
-        result = lint_model(model, shown, rules, options)
-        if cache is not None and not model.is_xacro:
-            cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
-        return result
-    # A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
-    # always reports syntax errors); only an explicit ignore hides it.
-    if matches(finding.rule, options.ignore) or _file_ignored(shown, finding.rule, options):
-        return LintResult(shown, False, [])
-    return LintResult(shown, False, [_override(finding, options)])
+        return unloaded_result(Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown), options)
+    result = lint_model(model, shown, rules, options)
+    if cache is not None and not model.is_xacro:
+        cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
+    return result
+
+
+def unloaded_result(finding: Finding, options: LintOptions) -> LintResult:
+    """The result of a file that did not load, ``finding`` (:func:`load_failure`) saying why.
+
+    A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
+    always reports syntax errors); only an explicit ignore hides it."""
+    if matches(finding.rule, options.ignore) or _file_ignored(finding.path, finding.rule, options):
+        return LintResult(finding.path, False, [])
+    return LintResult(finding.path, False, [_override(finding, options)])
 
 
 def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
@@ -273,12 +277,13 @@ def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
     list, not once per file (a bulk lint hands every file the same list)."""
     global _PARTITIONED
     given = tuple(rules)
-    if _PARTITIONED is None or _PARTITIONED[0] != given:  # the same rules: an identity check each
+    known = _PARTITIONED  # read once: another thread (an editor's server) may replace it meanwhile
+    if known is None or known[0] != given:  # the same rules: an identity check each
         static = [rule for rule in given if not rule.needs_sim and rule.check is not None]
         simulated = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) != "mujoco"]
         in_mujoco = [rule for rule in given if rule.needs_sim and ENGINE_OF.get(rule.code[0]) == "mujoco"]
-        _PARTITIONED = (given, (static, simulated, in_mujoco))
-    return _PARTITIONED[1]
+        known = _PARTITIONED = (given, (static, simulated, in_mujoco))
+    return known[1]
 
 
 _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
@@ -446,9 +451,10 @@ def suppressed_inline(element, code: str) -> bool:
     """
     global _LAST_IGNORES
     root = element.getroottree().getroot()
-    if _LAST_IGNORES is None or _LAST_IGNORES.root is not root:
-        _LAST_IGNORES = InlineIgnores(root)
-    return _LAST_IGNORES.suppresses(element, code)
+    known = _LAST_IGNORES  # read once: another thread may be linting another tree
+    if known is None or known.root is not root:
+        known = _LAST_IGNORES = InlineIgnores(root)
+    return known.suppresses(element, code)
 
 
 class InlineIgnores:

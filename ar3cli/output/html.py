@@ -14,36 +14,49 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from ar3cli.output.html_charts import heat_map_svg, torque_chart_svg
-from ar3cli.output.html_page import badge, esc, findings_section, number, page, severity_counts
+from ar3cli.output.html_page import SEVERITIES, badge, esc, findings_section, number, page, severity_counts
 
 SECTIONS = (("summary", "Summary"), ("tree", "Kinematic tree"), ("renders", "Pictures"),
             ("findings", "Findings"), ("collisions", "Self-collision matrix"), ("torques", "Torque margins"),
             ("fk", "FK verification"), ("cross-check", "Cross-check"))
+STATUS_BADGE = {"fail": ("fail", "\u2716 FAIL"), "warning": ("warning", "\u25b2 WARNING"), "pass": ("ok", "\u2714 PASS"),
+                "not checked": ("unchecked", "\u2013 NOT CHECKED")}
+"""A check's status as a badge: class and words (with a shape: colour is never the only cue)."""
 
 
 def robot_page(data: Mapping[str, Any], context: Mapping[str, Any], pictures: Sequence[Mapping[str, Any]]) -> str:
-    """The report of one robot. ``data``: ``info``, ``lint``, ``collisions``, ``fk`` (JSON documents;
-    a section that could not be computed is None and ``data["skipped"][section]`` says why),
-    ``cross_check`` (None until that feature exists: its section says so), ``settings``.
-    ``context``: ``lines`` (each section's summary lines), ``sources`` and ``fixes`` (for the
-    findings). ``pictures``: ``side``, ``geometry``, ``png`` (bytes), ``contacts``, or ``error``."""
+    """The report of one robot: the verdict first, then one collapsed section per part, each showing
+    its own verdict and count until it is opened. ``data``: ``verdict`` (``analysis.verdict.Verdict``'s
+    JSON: ``status``, ``headline``, ``checks`` with ``key``, ``title``, ``status``, ``line``, ``count``;
+    ``notes``), ``home`` (the home pose), ``info``, ``lint``, ``collisions``, ``fk``, ``cross_check``
+    (JSON documents; a section that could not be computed is None and ``data["skipped"][section]``
+    says why; ``cross_check`` is None without MuJoCo), ``settings``. ``context``: ``lines`` (each
+    section's summary lines), ``sources`` and ``fixes`` (for the findings). ``pictures``: ``side``,
+    ``geometry``, ``png`` (bytes), ``contacts``, or ``error``."""
     info, lint = data.get("info") or {}, data.get("lint") or {}
     skipped = data.get("skipped", {})
     lines = context.get("lines", {})
+    verdict = data.get("verdict") or {}
+    checks = {check.get("key"): check for check in verdict.get("checks", [])}
     title = f"ar3cli report: {info.get('name') or info.get('path') or 'robot'}"
+    links = len(info.get("links", []))
     body = [f"<h1>{esc(title)}</h1>", f'<p class="mono muted">{esc(info.get("path"))}; '
             f'{esc(data.get("settings", {}).get("described", ""))}</p>',
+            _verdict(verdict),
             "<nav>" + "".join(f'<a href="#{key}">{esc(name)}</a>' for key, name in SECTIONS) + "</nav>",
-            _section("summary", _summary(info, lint, lines.get("info", []))),
-            _section("tree", _tree(info)),
-            _section("renders", _pictures(pictures)),
+            f'<section id="summary"><h2>Summary</h2>{_summary(info, lines.get("info", []))}</section>\n',
+            _section("tree", _tree(info), note=f"{links} link{'s' if links != 1 else ''}, "
+                                                f"{int(info.get('dof') or 0)} DOF"),
+            _section("renders", _pictures(pictures, data.get("home")), checks.get("renders")),
             _section("findings", severity_counts(lint.get("summary", {}))
-                     + findings_section(lint.get("findings", []), context)),
+                     + findings_section(lint.get("findings", []), context), checks.get("findings")),
             _section("collisions", _collisions(data.get("collisions"), lines.get("collisions", []),
-                                               skipped.get("collisions"))),
-            _section("torques", _torques(info.get("torques"), lines.get("torques", []), skipped.get("torques"))),
-            _section("fk", _fk(data.get("fk"), lines.get("fk", []), skipped.get("fk"))),
-            _section("cross-check", _cross_check(data.get("cross_check")))]
+                                               skipped.get("collisions")), checks.get("collisions")),
+            _section("torques", _torques(info.get("torques"), lines.get("torques", []), skipped.get("torques")),
+                     checks.get("torques")),
+            _section("fk", _fk(data.get("fk"), lines.get("fk", []), skipped.get("fk")), checks.get("fk")),
+            _section("cross-check", _cross_check(data.get("cross_check"), skipped.get("cross_check")),
+                     checks.get("cross-check"))]
     return page(title, body, data)
 
 
@@ -66,9 +79,44 @@ def lint_page(data: Mapping[str, Any], context: Mapping[str, Any]) -> str:
     return page("ar3cli lint-urdf", body, data)
 
 
-def _section(key: str, content: str) -> str:
+def _section(key: str, content: str, check: Mapping[str, Any] | None = None, note: str = "") -> str:
+    """A section collapsed to one line: its title, its check's status badge, count and line (or a
+    ``note`` for a section without a verdict); the content one click away."""
     name = dict(SECTIONS)[key]
-    return f'<section id="{key}"><h2>{esc(name)}</h2>{content}</section>\n'
+    status = str(check.get("status")) if check else ""
+    head = f"<h2>{esc(name)}</h2>"
+    if check:
+        count = int(check.get("count") or 0)
+        head += (f" {status_badge(status)}" + (f' <b class="count" data-check-count="{count}">{count}</b>' if count
+                                               else "") + f' <span class="line">{esc(check.get("line"))}</span>')
+    elif note:
+        head += f' <span class="line">{esc(note)}</span>'
+    return (f'<details class="section" id="{key}" data-status="{esc(status)}"><summary>{head}</summary>'
+            f'<div class="body">{content}</div></details>\n')
+
+
+def status_badge(status: str) -> str:
+    """A check's status (``fail``, ``warning``, ``pass``, ``not checked``) as a badge with its word and shape."""
+    css, words = STATUS_BADGE.get(status, ("unchecked", status.upper()))
+    return f'<span class="badge {css}">{esc(words)}</span>'
+
+
+def _verdict(verdict: Mapping[str, Any]) -> str:
+    """The page's one verdict: the worst status of every section's check, its headline, one row per
+    check (linking to its section) and the notes a reader needs first (the home pose is not all zeros)."""
+    if not verdict:
+        return ""
+    status = str(verdict.get("status"))
+    headline = str(verdict.get("headline", ""))
+    words = headline.split(": ", 1)[1] if ": " in headline else headline
+    rows = "".join(f'<tr data-check="{esc(check.get("key"))}" data-status="{esc(check.get("status"))}">'
+                   f'<td>{status_badge(str(check.get("status")))}</td>'
+                   f'<td><a href="#{esc(check.get("key"))}">{esc(check.get("title"))}</a></td>'
+                   f'<td>{esc(check.get("line"))}</td></tr>' for check in verdict.get("checks", []))
+    notes = _lines([f"note: {note}" for note in verdict.get("notes", [])])
+    return (f'<section id="verdict" class="verdict {esc(STATUS_BADGE.get(status, ("unchecked",))[0])}" '
+            f'data-verdict="{esc(status)}"><p class="headline">{status_badge(status)} {esc(words)}</p>'
+            f'<table class="checks">{rows}</table>{notes}</section>\n')
 
 
 def _skipped(why: str | None) -> str:
@@ -79,18 +127,19 @@ def _lines(lines: Sequence[str]) -> str:
     return "<ul>" + "".join(f"<li>{esc(line)}</li>" for line in lines) + "</ul>" if lines else ""
 
 
-def _summary(info: Mapping[str, Any], lint: Mapping[str, Any], lines: Sequence[str]) -> str:
+def _summary(info: Mapping[str, Any], lines: Sequence[str]) -> str:
     box = (info.get("bounding_box_m") or {}).get("size")
-    cards = [("links", info.get("link_count")), ("joints", info.get("joint_count")), ("DOF", info.get("dof")),
-             ("mass (kg)", number(info.get("total_mass_kg"))),
-             ("size (m)", " x ".join(number(v, 3) for v in box) if box else "-"),
-             ("lint", "FAILED" if (lint.get("summary") or {}).get("failed") else "passed")]
-    keys = ("link_count", "joint_count", "dof", "total_mass_kg", "", "")
+    cards = [("links", info.get("link_count"), "link_count"), ("joints", info.get("joint_count"), "joint_count"),
+             ("DOF", info.get("dof"), "dof"), ("mass (kg)", number(info.get("total_mass_kg")), "total_mass_kg"),
+             ("size (m)", " x ".join(number(v, 3) for v in box) if box else "-", "")]
     html = ['<div class="cards">']
-    for (label, value), key in zip(cards, keys):
+    for label, value, key in cards:
         attribute = f' data-info="{key}"' if key else ""
         html.append(f'<div class="card">{esc(label)}<b{attribute}>{esc(value)}</b></div>')
-    return "".join(html) + "</div>" + _lines(lines)
+    html.append("</div>")
+    if lines:
+        html.append(f"<details><summary>{len(lines)} facts (info)</summary>{_lines(lines)}</details>")
+    return "".join(html)
 
 
 def _tree(info: Mapping[str, Any]) -> str:
@@ -126,7 +175,7 @@ def _tree(info: Mapping[str, Any]) -> str:
     return "".join(out)
 
 
-def _pictures(pictures: Sequence[Mapping[str, Any]]) -> str:
+def _pictures(pictures: Sequence[Mapping[str, Any]], home: Mapping[str, Any] | None) -> str:
     if not pictures:
         return _skipped(None)
     out, contacts = [], {}
@@ -141,18 +190,64 @@ def _pictures(pictures: Sequence[Mapping[str, Any]]) -> str:
                    "</figcaption></figure>")
         for contact in picture.get("contacts", []):
             contacts[(contact["link_a"], contact["link_b"])] = contact["depth_m"]
+    pose = _home_pose(home)
     note = ("<p>Links in contact at the home pose are drawn red "
             f"({len(contacts)} pair{'s' if len(contacts) != 1 else ''}):</p>" + _lines(
                 [f"{a} / {b}: {number(depth, 3)} m deep" for (a, b), depth in sorted(contacts.items())])
             if contacts else "<p>No two non-adjacent links are in contact at the home pose.</p>")
-    return "<div>" + "".join(out) + "</div>" + note + \
+    return pose + "<div>" + "".join(out) + "</div>" + note + \
         '<p class="muted">Collision geometry is drawn blue; contacts red.</p>'
+
+
+def _home_pose(home: Mapping[str, Any] | None) -> str:
+    """Which pose the pictures show: every joint at 0, or which joints are not and why."""
+    if not home:
+        return ""
+    away = home.get("away_from_zero") or {}
+    if not away:
+        return '<p data-home="zero">Drawn at the home pose: every joint at 0.</p>'
+    values = home.get("values") or {}
+    items = [f"{name} = {number(values.get(name))} ({why})" for name, why in away.items()]
+    return (f'<p data-home="moved">Drawn at the home pose, which is not all zeros: {len(items)} '
+            f'joint{"s" if len(items) != 1 else ""} at another value:</p>' + _capped(items))
+
+
+LIST_SHOWN = 8
+"""Items of a long list shown before the rest is folded into one more click."""
+
+
+def _capped(items: Sequence[str]) -> str:
+    """A list of the first :data:`LIST_SHOWN` items, the rest behind a ``<details>`` with their count."""
+    if len(items) <= LIST_SHOWN:
+        return _lines(items)
+    return (_lines(items[:LIST_SHOWN]) + f"<details><summary>and {len(items) - LIST_SHOWN} more</summary>"
+            f"{_lines(items[LIST_SHOWN:])}</details>")
+
+
+WARNING_WORDS = {"contact-at-home": ("pair", "in contact at the home pose but not adjacent"),
+                 "pybullet-default-self-collision": ("pair", "always in contact, yet checked by PyBullet's "
+                                                             "URDF_USE_SELF_COLLISION"),
+                 "contact-only-at-limits": ("pair", "touching only at a joint limit (kept enabled)"),
+                 "visual-only-links": ("warning", "about links with <visual> but no <collision>")}
+"""What each kind of collision-matrix warning is about (its noun and the rest), for its one grouped line."""
 
 
 def _collisions(collisions: Mapping[str, Any] | None, lines: Sequence[str], why: str | None) -> str:
     if not collisions:
         return _skipped(why)
-    return _lines(lines) + heat_map_svg(collisions)
+    groups: dict[tuple[str, str], list[Mapping[str, Any]]] = {}
+    for warning in collisions.get("warnings", []):
+        groups.setdefault((str(warning.get("severity")), str(warning.get("rule"))), []).append(warning)
+    order = {level: rank for rank, level in enumerate(SEVERITIES)}
+    grouped = []
+    for (severity, rule), members in sorted(groups.items(), key=lambda item: order.get(item[0][0], len(order))):
+        noun, what = WARNING_WORDS.get(rule, ("finding", rule))
+        hint = members[0].get("hint")
+        grouped.append(f'<details class="group" data-rule="{esc(rule)}" data-group-count="{len(members)}"><summary>'
+                       f'{badge(severity)} {len(members)} {noun}{"s" if len(members) != 1 else ""} {esc(what)}</summary>'
+                       + _lines([str(member.get("message")) for member in members])
+                       + (f'<p class="muted">hint: {esc(hint)}</p>' if hint else "") + "</details>")
+    return _lines(lines) + "".join(grouped) + heat_map_svg(collisions)
 
 
 def _torques(torques: Mapping[str, Any] | None, lines: Sequence[str], why: str | None) -> str:
@@ -164,20 +259,20 @@ def _torques(torques: Mapping[str, Any] | None, lines: Sequence[str], why: str |
 def _fk(fk: Mapping[str, Any] | None, lines: Sequence[str], why: str | None) -> str:
     if not fk:
         return _skipped(why)
-    verdict = '<span class="badge ok">\u2714 PASS</span>' if fk.get("passed") else \
-        '<span class="badge fail">\u2716 FAIL</span>'
+    verdict = status_badge("pass" if fk.get("passed") else "fail")
     return (f'<p data-fk-passed="{str(bool(fk.get("passed"))).lower()}">{verdict} max position error '
             f'{number(fk.get("max_position_error_m"), 3)} m, max orientation error '
             f'{number(fk.get("max_orientation_error_rad"), 3)} rad over {int(fk.get("samples", 0))} samples</p>'
             + _lines(lines))
 
 
-def _cross_check(result: Mapping[str, Any] | None) -> str:
+def _cross_check(result: Mapping[str, Any] | None, why: str | None = None) -> str:
     """``cross-check``'s verdict: the command puts its JSON document in ``data["cross_check"]``
-    (``passed`` and ``lines``), or None where MuJoCo is not installed."""
+    (``passed`` and ``lines``), or None where MuJoCo is not installed (or the check could not run: ``why``)."""
+    if why:
+        return _skipped(why)
     if not result:
         return ('<p class="muted">MuJoCo is not installed here: <code>pip install \'ar3cli[mujoco]\'</code> '
                 'adds PyBullet-against-MuJoCo agreement to this page.</p>')
-    verdict = '<span class="badge ok">\u2714 PASS</span>' if result.get("passed") else \
-        '<span class="badge fail">\u2716 FAIL</span>'
+    verdict = status_badge("pass" if result.get("passed") else "fail")
     return f"<p>{verdict}</p>" + _lines([str(line) for line in result.get("lines", [])])

@@ -1,4 +1,5 @@
-"""Inline SVG charts for the HTML report: the self-collision matrix as a heat map and the gravity
+"""Inline SVG charts for the HTML report: the self-collision matrix as a heat map (in the colours and
+letters of ``sample-collisions --png``: :mod:`ar3cli.output.collision_palette`) and the gravity
 torque margins as a bar chart. Plain data in (the JSON documents of sample-collisions and
 ``info --torques``), SVG text out; every name is escaped, every cell and bar has a ``<title>`` (the
 browser's hover) and the legend says in words what each colour means."""
@@ -8,32 +9,37 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ar3cli.output.collision_palette import (
+    CATEGORY_COLOURS,
+    CATEGORY_LETTERS,
+    LEGEND,
+    LIMIT_ONLY,
+    RAMP,
+    SCALE_LOW,
+    SCALE_TICKS,
+    SCALE_TITLE,
+    hex_colour,
+    ink,
+    pair_colour,
+    pair_letter,
+    ramp_colour,
+    scale_position,
+)
 from ar3cli.output.html_page import esc, number
 
-RAMP = ("#ffffcc", "#c7e9b4", "#7fcdbb", "#41b6c4", "#1d91c0", "#225ea8", "#0c2c84")
-"""ColorBrewer YlGnBu: sequential, readable with every common colour-vision deficiency and in grey."""
-CATEGORY_FILL = {"adjacent": "#bdbdbd", "never": "#ffffff", "default": "#D55E00"}
-"""Fixed fills; 'sometimes' and 'always' take the ramp by fraction (always is its dark end)."""
 MAX_MATRIX_PX = 760
 LABEL_PX = 150
-
-
-def ramp(fraction: float) -> str:
-    """The ramp colour of a collision fraction in [0, 1]."""
-    position = min(max(fraction, 0.0), 1.0) ** 0.5  # small fractions stay visible
-    return RAMP[min(int(position * (len(RAMP) - 1) + 0.5), len(RAMP) - 1)]
-
-
-def cell_fill(pair: Mapping[str, Any]) -> str:
-    category = str(pair.get("category"))
-    if category in CATEGORY_FILL:
-        return CATEGORY_FILL[category]
-    return ramp(float(pair.get("fraction") or 0.0))
+"""The most room the link names get (names longer than this are cut by the SVG's edge, the hover has them)."""
+LETTER_PX = 12
+"""Cells at least this large hold their letter (or count), as the PNG's do."""
+SCALE_PX = 240
+SCALE_STEPS = 48
 
 
 def heat_map_svg(collisions: Mapping[str, Any]) -> str:
-    """The lower triangle of the link-pair matrix; hover (``<title>``) shows the pair, its category
-    and the fraction of samples in collision. Cells touching at home get a black outline too."""
+    """The lower triangle of the link-pair matrix in the PNG's colours and letters; hover
+    (``<title>``) shows the pair, its category and the fraction of samples in collision. Cells
+    touching at home get a black outline too."""
     links = [str(name) for name in collisions.get("links", [])]
     index = {name: at for at, name in enumerate(links)}
     count = len(links)
@@ -41,14 +47,16 @@ def heat_map_svg(collisions: Mapping[str, Any]) -> str:
         return '<p class="muted">fewer than two links with collision geometry: no matrix.</p>'
     cell = max(3, min(18, MAX_MATRIX_PX // count))
     font = max(5, min(11, cell - 2))
-    size = LABEL_PX + cell * count
-    parts = [f'<svg class="heat" width="{size + 10}" height="{size + 10}" '
-             f'viewBox="0 0 {size + 10} {size + 10}" role="img" aria-label="self-collision matrix">']
+    label = int(min(LABEL_PX, max(40, 0.62 * font * max(len(name) for name in links) + 10)))
+    size = label + cell * count
+    width = size + 10 + label // 2  # the last column's name leans right by half its length (rotated -60 degrees)
+    parts = [f'<svg class="heat" width="{width}" height="{size + 10}" '
+             f'viewBox="0 0 {width} {size + 10}" role="img" aria-label="self-collision matrix">']
     for at, name in enumerate(links):
-        y = LABEL_PX + at * cell + cell * 0.75
-        x = LABEL_PX + at * cell + cell * 0.75
-        parts.append(f'<text x="{LABEL_PX - 4}" y="{y:.1f}" font-size="{font}" text-anchor="end">{esc(name)}</text>')
-        parts.append(f'<text transform="translate({x:.1f},{LABEL_PX - 4}) rotate(-60)" font-size="{font}">'
+        y = label + at * cell + cell * 0.75
+        x = label + at * cell + cell * 0.75
+        parts.append(f'<text x="{label - 4}" y="{y:.1f}" font-size="{font}" text-anchor="end">{esc(name)}</text>')
+        parts.append(f'<text transform="translate({x:.1f},{label - 4}) rotate(-60)" font-size="{font}">'
                      f'{esc(name)}</text>')
     samples = collisions.get("samples")
     for pair in collisions.get("pairs", []):
@@ -63,23 +71,44 @@ def heat_map_svg(collisions: Mapping[str, Any]) -> str:
         tip = f"{pair.get('link_a')} / {pair.get('link_b')}: {pair.get('category')}, {fraction}" + \
             ("; in contact at home" if at_home else "")
         outline = ' stroke="#000" stroke-width="1"' if at_home else ' stroke="#e0e0e0" stroke-width="0.5"'
-        parts.append(f'<rect x="{LABEL_PX + column * cell}" y="{LABEL_PX + row * cell}" width="{cell}" height="{cell}" '
-                     f'fill="{cell_fill(pair)}"{outline} data-category="{esc(pair.get("category"))}" '
-                     f'data-fraction="{esc(pair.get("fraction"))}"><title>{esc(tip)}</title></rect>')
+        fill = pair_colour(str(pair.get("category")), float(pair.get("fraction") or 0.0))
+        x, y = label + column * cell, label + row * cell
+        parts.append(f'<rect x="{x}" y="{y}" width="{cell}" height="{cell}" fill="{hex_colour(fill)}"{outline} '
+                     f'data-category="{esc(pair.get("category"))}" data-fraction="{esc(pair.get("fraction"))}">'
+                     f'<title>{esc(tip)}</title></rect>')
+        letter = pair_letter(str(pair.get("category")), int(pair.get("collisions") or 0))
+        if letter and cell >= LETTER_PX and len(letter) <= max(1, cell // 6):
+            parts.append(f'<text x="{x + cell / 2:.1f}" y="{y + cell / 2:.1f}" font-size="{max(6, cell - 8)}" '
+                         f'text-anchor="middle" dominant-baseline="central" fill="{ink(fill)}" '
+                         f'pointer-events="none">{esc(letter)}</text>')
     parts.append("</svg>")
     return "".join(parts) + heat_legend()
 
 
 def heat_legend() -> str:
-    """The colours of the heat map, each with its meaning in words."""
-    items = [(CATEGORY_FILL["adjacent"], "adjacent (a link and its parent: not checked)"),
-             (CATEGORY_FILL["never"], "never collided"),
-             (CATEGORY_FILL["default"], "default: in contact at the home pose (outlined)"),
-             (ramp(0.01), "sometimes: 1% of samples"), (ramp(0.2), "20%"), (ramp(0.6), "60%"),
-             (ramp(1.0), "always: 95% or more")]
-    return "<p>" + " ".join(f'<span style="display:inline-block;width:1em;height:1em;background:{fill};'
-                            f'border:1px solid #555;vertical-align:middle"></span> {esc(text)}&nbsp;'
-                            for fill, text in items) + "</p>"
+    """The colours of the heat map, each with its meaning in words, and the 'sometimes' scale with its
+    numbers: the legend of ``sample-collisions --png``."""
+    def swatch(fill: tuple[int, int, int], letter: str) -> str:
+        return (f'<span class="swatch" style="background:{hex_colour(fill)};color:{ink(fill)}">'
+                f'{esc(letter)}</span>')
+
+    items = [swatch(CATEGORY_COLOURS[category], CATEGORY_LETTERS[category]) + f" {esc(text)}"
+             for category, text in LEGEND]
+    step = SCALE_PX / SCALE_STEPS
+    bar = [f'<rect x="{i * step:.1f}" y="0" width="{step + 0.5:.1f}" height="14" '
+           f'fill="{hex_colour(ramp_colour(i / (SCALE_STEPS - 1)))}"/>' for i in range(SCALE_STEPS)]
+    ticks = []
+    for tick in SCALE_TICKS:
+        x = scale_position(tick) * SCALE_PX
+        anchor = "start" if tick == SCALE_TICKS[0] else "end" if tick == SCALE_TICKS[-1] else "middle"
+        label = f"{100 * tick:g}%" if tick > SCALE_LOW else f"&lt;= {100 * tick:g}%"
+        ticks.append(f'<line x1="{x:.1f}" y1="14" x2="{x:.1f}" y2="18" stroke="#000"/>'
+                     f'<text x="{x:.1f}" y="29" font-size="10" text-anchor="{anchor}">{label}</text>')
+    scale = (f'<svg width="{SCALE_PX + 2}" height="32" viewBox="-1 0 {SCALE_PX + 2} 32" role="img" '
+             f'aria-label="colour scale of the sometimes category">{"".join(bar)}'
+             f'<rect x="0" y="0" width="{SCALE_PX}" height="14" fill="none" stroke="#5a5a5a"/>{"".join(ticks)}</svg>')
+    return (f'<p class="legend">{"&nbsp; ".join(items)}</p><p class="legend">{esc(SCALE_TITLE)}<br>{scale} '
+            f'{swatch(RAMP[0], LIMIT_ONLY)} only at a joint limit</p>')
 
 
 BAR_PX = 360

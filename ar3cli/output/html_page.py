@@ -37,6 +37,20 @@ vertical-align:top}th{background:var(--panel)}td.num{text-align:right;font-varia
 .badge{display:inline-block;padding:0 .45rem;border-radius:.6rem;font-weight:600;color:#fff;white-space:nowrap}
 .badge.error{background:var(--error)}.badge.warning{background:var(--warning);color:#1b1b1b}
 .badge.info{background:var(--info)}.badge.ok{background:var(--ok)}.badge.fail{background:var(--error)}
+.badge.unchecked{background:#d9d9d9;color:var(--ink)}
+.verdict{border:2px solid var(--line);border-left-width:10px;padding:.5rem .9rem;margin:.6rem 0 1rem;background:var(--panel)}
+.verdict.fail{border-color:var(--error)}.verdict.warning{border-color:var(--warning)}.verdict.ok{border-color:var(--ok)}
+.verdict .headline{font-size:1.2rem;font-weight:600;margin:.2rem 0 .5rem}
+.verdict table.checks td{border:none;padding:.1rem .5rem .1rem 0}.verdict ul{margin:.3rem 0}
+.verdict table.checks td:nth-child(-n+2){white-space:nowrap}
+details.section{border-bottom:2px solid var(--line);margin-top:.4rem}
+details.section>summary{cursor:pointer;padding:.35rem 0;list-style-position:outside}
+details.section>summary h2{display:inline;border:none;margin:0 .5rem 0 0;padding:0}
+details.section>summary .count{margin:0 .3rem}details.section>summary .line{color:var(--muted)}
+details.section>.body{padding:.2rem 0 .8rem}
+details.group{margin:.3rem 0}details.group>summary{cursor:pointer}
+.legend{font-size:.9rem}.swatch{display:inline-block;width:1.1em;height:1.1em;line-height:1.1em;text-align:center;
+font-size:.75em;font-weight:600;border:1px solid #555;vertical-align:middle}
 .finding{border-left:6px solid var(--line);background:var(--panel);margin:.5rem 0;padding:.4rem .7rem}
 .finding.error{border-color:var(--error)}.finding.warning{border-color:var(--warning)}
 .finding.info{border-color:var(--info)}
@@ -65,11 +79,23 @@ SCRIPT = """
   function all(open){document.querySelectorAll('details').forEach(function(d){d.open=open;});}
   document.querySelectorAll('button[data-details]').forEach(function(b){
     b.addEventListener('click', function(){all(b.getAttribute('data-details')==='open');});});
+  function reveal(){
+    var target = location.hash ? document.getElementById(location.hash.slice(1)) : null;
+    if (target && target.tagName === 'DETAILS') { target.open = true; }
+  }
+  window.addEventListener('hashchange', reveal);
+  document.querySelectorAll('a[href^="#"]').forEach(function(a){
+    a.addEventListener('click', function(){
+      var target = document.getElementById(a.getAttribute('href').slice(1));
+      if (target && target.tagName === 'DETAILS') { target.open = true; }
+    });});
+  reveal();
   window.addEventListener('beforeprint', function(){all(true);});
 })();
 """
 """The page's only script: parses the data island (a broken one is a console error the browser test
-sees), expand/collapse buttons, and every <details> opened for printing."""
+sees), expand/collapse buttons, a collapsed section opened when a link (the verdict's, the
+navigation's) or the address leads to it, and every <details> opened for printing."""
 
 
 def esc(value: Any) -> str:

@@ -43,6 +43,7 @@ from ar3cli.errors import UserError
 from ar3cli.infra.isolation import report_stage
 from ar3cli.sim.capture import capture_fds
 from ar3cli.sim.loadable_copy import LineMap, user_lines
+from ar3cli.urdf.home import home_value, sample_range
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 Result = TypeVar("Result")
@@ -106,16 +107,11 @@ class JointRecord:
 
     def sample_range(self) -> tuple[float, float]:
         """Where a uniform sampler should draw: [-pi, pi) for continuous or unlimited revolute joints."""
-        if self.lower is not None and self.upper is not None:
-            return self.lower, self.upper
-        if self.urdf_type == "prismatic":
-            return -1.0, 1.0
-        return -math.pi, math.pi
+        return sample_range(self.urdf_type, self.lower, self.upper)
 
     def home(self) -> float:
-        """0, or mid-range when 0 is outside the limits (MoveIt's convention)."""
-        lower, upper = self.sample_range()
-        return 0.0 if lower <= 0.0 <= upper else (lower + upper) / 2.0
+        """0, or mid-range when 0 is outside the limits (MoveIt's convention: :mod:`ar3cli.urdf.home`)."""
+        return home_value(*self.sample_range())
 
 
 @dataclass(frozen=True)

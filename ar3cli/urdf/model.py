@@ -252,6 +252,9 @@ class Model:
     quirks: list[Quirk] = field(default_factory=list)
     links: list[Link] = field(default_factory=list)
     joints: list[Joint] = field(default_factory=list)
+    expansion: Any = field(default=None, repr=False, compare=False)
+    """A xacro file's :class:`~ar3cli.urdf.xacro_expand.Expansion` (its elements' origins, the files
+    it included), held so they stay known while the model is in use; None for a URDF."""
 
     # ---- lookups -------------------------------------------------------------------------
     @property
@@ -381,20 +384,24 @@ def load_model(
     """Read, expand (xacro), parse and index one robot file; bad input raises :class:`UserError`.
 
     ``source`` stands in for the file's bytes (a fixer's result, checked before anything is
-    written); ``path`` still says where relative mesh paths start.
+    written; an editor's unsaved buffer, xacro expanded from it); ``path`` still says where relative
+    mesh paths and included files start.
     """
     path = Path(path)
+    given = source
     source = read_bytes(path) if source is None else source
     if not source.strip(b"\x00 \t\r\n"):
         raise UserError(f"{path}: file is empty")
     resolver = PackageResolver(path.parent, package_paths)
     xmlsource.refuse_entities(source, path)
     quirks: list[Quirk] = []
+    expansion = None
     if is_xacro(path):
-        from ar3cli.urdf.xacro_expand import expand
+        from ar3cli.urdf.xacro_expand import expand, expansion_of
 
         _, quirks = xmlsource.normalize(source)
-        xml_bytes = expand(path, dict(xacro_args or {}), resolver)
+        xml_bytes = expand(path, dict(xacro_args or {}), resolver, source=given)
+        expansion = expansion_of(xml_bytes)
         xmlsource.refuse_entities(xml_bytes, path)  # an included file may declare some
     else:
         xml_bytes, quirks = xmlsource.normalize(source)
@@ -404,7 +411,7 @@ def load_model(
         raise UserError(f"{path}:{root.sourceline or 1}: root element is <{root.tag}>, expected <robot>; "
                         "is this a URDF file?")
     return Model(path=path, root=root, source_bytes=source, xml_bytes=xml_bytes,
-                 is_xacro=is_xacro(path), resolver=resolver, quirks=quirks,
+                 is_xacro=is_xacro(path), resolver=resolver, quirks=quirks, expansion=expansion,
                  links=[_read_link(element, resolver) for element in root.findall("link")],
                  joints=[_read_joint(element) for element in root.findall("joint")])
 

@@ -19,10 +19,12 @@ xacro alone writes. :func:`origins` gives the linter each element's origin, in d
 
 from __future__ import annotations
 
+import collections
 import contextlib
 import io
 import os
 import re
+import weakref
 from pathlib import Path
 from typing import NamedTuple
 
@@ -45,15 +47,35 @@ class Origin(NamedTuple):
 ORIGIN_ATTRIBUTE = "ar3cli-origin"
 """The attribute that carries an element's origin through xacro (taken off before the output)."""
 _KEEP_ORIGINS = 4
-"""Expansions whose origins are kept: a file is linted right after it is expanded."""
-_origins: dict[bytes, tuple[list[Origin | None], list[str]]] = {}
+"""Expansions whose origins are kept in any case: a file is linted right after it is expanded."""
+
+
+class Expansion:
+    """What an expansion knows beyond its URDF: each element's origin and the files xacro read.
+    A :class:`~ar3cli.urdf.model.Model` holds its own (``Model.expansion``), so :func:`origins`
+    answers for every model still in use (an editor's open files), not only the last few."""
+
+    __slots__ = ("found", "included", "__weakref__")
+
+    def __init__(self, found: list[Origin | None], included: list[str]) -> None:
+        self.found = found
+        self.included = included
+
+
+_origins: weakref.WeakValueDictionary[bytes, Expansion] = weakref.WeakValueDictionary()
+_recent: collections.deque[Expansion] = collections.deque(maxlen=_KEEP_ORIGINS)
+
+
+def expansion_of(xml_bytes: bytes) -> Expansion | None:
+    """The :class:`Expansion` of bytes :func:`expand` returned (None for other bytes)."""
+    return _origins.get(xml_bytes)
 
 
 def origins(xml_bytes: bytes) -> list[Origin | None] | None:
     """The origin of each element of an expansion :func:`expand` returned, in document order
     (None for an element xacro made itself, such as ``xacro:element``); None for other bytes."""
     kept = _origins.get(xml_bytes)
-    return kept[0] if kept is not None else None
+    return kept.found if kept is not None else None
 
 
 def set_policy(policy: XacroPolicy) -> None:
@@ -86,9 +108,10 @@ class _Expansion(NamedTuple):
     notes: list[str]
 
 
-def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes:
+def expand(path: Path, args: dict[str, str], resolver: PackageResolver, source: bytes | None = None) -> bytes:
     """Return the expanded URDF as UTF-8 bytes (and keep its elements' :func:`origins` and
-    :func:`included_files`).
+    :func:`included_files`). ``source`` stands in for the bytes of ``path`` itself (an editor's
+    unsaved buffer); the files it includes are read from disk as usual.
 
     The expansion runs in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`) with CPU,
     memory and wall-clock limits, under the current policy (safe mode by default,
@@ -104,7 +127,7 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
     def work() -> _Expansion:
         if os.getpid() != parent:  # in the child (where fork is missing, the work runs here: no limits)
             _limit_this_process()
-        return _expand_here(path, args, resolver, policy)
+        return _expand_here(path, args, resolver, policy, source)
 
     try:
         result = run_isolated(work, str(path))
@@ -115,16 +138,16 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
         raise UserError(f"{path}: xacro error: the expansion died ({exc.signal_name})") from None
     for line in result.notes:
         log(f"ar3cli: note: {path}: xacro says: {line}")
-    while len(_origins) >= _KEEP_ORIGINS:
-        del _origins[next(iter(_origins))]
-    _origins[result.data] = (result.found, result.included)
+    kept = Expansion(result.found, result.included)
+    _origins[result.data] = kept
+    _recent.append(kept)
     return result.data
 
 
 def included_files(xml_bytes: bytes) -> list[str]:
     """The files xacro read (includes, YAML) for an expansion :func:`expand` returned, as xacro named them."""
     kept = _origins.get(xml_bytes)
-    return list(kept[1]) if kept is not None else []
+    return list(kept.included) if kept is not None else []
 
 
 def _limit_this_process() -> None:
@@ -145,7 +168,8 @@ def _limit_this_process() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (wanted if hard == resource.RLIM_INFINITY else min(wanted, hard), hard))
 
 
-def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, policy: XacroPolicy) -> _Expansion:
+def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, policy: XacroPolicy,
+                 source: bytes | None = None) -> _Expansion:
     """The expansion itself, in this process.
 
     xacro keeps module-level state and prints diagnostics with ``print``; both are contained
@@ -173,7 +197,8 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
     kept: dict = {}
     original_find, original_parse = substitution_args._eval_find, xacro.parse
     substitution_args._eval_find = find_package
-    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots)
+    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots,
+                                      {str(path): source} if source is not None else {})
     chatter = io.StringIO()
     included_before = len(xacro.all_includes)
     try:
@@ -248,7 +273,8 @@ def _arguments_hint(path: Path, given: dict[str, str]) -> str:
     return f"; the file takes xacro arguments ({shown}): pass the ones it needs with --xacro-arg NAME:=VALUE"
 
 
-def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None):
+def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None,
+                        sources: dict[str, bytes] | None = None):
     """xacro's ``parse(inp, filename)``, noting the origin of each element read from a file.
 
     The file is read as xacro reads it (text, default encoding) and parsed by the builder
@@ -259,6 +285,7 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
     xacro to evaluate: 3 ms less on the AR3). xacro's own elements are left alone (xacro checks
     their attributes); inside ``xacro:if``/``xacro:unless`` nodes are moved, never copied.
     With ``roots`` (safe mode), an existing file is read only inside them, through the capped reader.
+    ``sources`` maps a file name as xacro names it to the bytes that stand in for the file.
     """
     import locale
     from xml.dom import expatbuilder
@@ -300,6 +327,8 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
         if inp is not None or filename is None:
             return original_parse(inp, filename)
         full = os.path.join(getattr(xacro, "root_dir", os.curdir), filename)
+        if sources and str(filename) in sources:
+            return Builder(str(filename)).parseString(sources[str(filename)].decode("utf-8", "replace"))
         if roots is not None and os.path.lexists(full):
             text = read_inside(roots, full).decode(locale.getpreferredencoding(False))  # as open() decodes
             return Builder(str(filename)).parseString(text)
