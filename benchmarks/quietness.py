@@ -191,7 +191,8 @@ class Finding:
     """One lint-urdf finding of the corpus, with the key its verdict is filed under."""
 
     package: str
-    file: str  # PACKAGE/path inside the package
+    file: str  # PACKAGE/path of the file the finding points into
+    entry: str  # PACKAGE/path of the file that was linted (differs for findings in an included xacro file)
     group: str
     rule: str
     severity: str
@@ -270,11 +271,13 @@ def _lint_group(run: Run, command: list[str], env: dict[str, str], cwd: str, pac
     def rel(path: str) -> str:
         return f"{package}/{Path(path).resolve().relative_to(folder.resolve()).as_posix()}"
 
+    items = iter(report["findings"])  # in the order of report["files"], each file's count in turn
     for record in report["files"]:
-        run.files.append(FileRecord(package, rel(record["path"]), group, record["findings"], record["error"]))
-    for item in report["findings"]:
-        run.findings.append(Finding(package, rel(item["path"]), group, item["rule"], item["severity"],
-                                    int(item.get("line") or 0), item["message"]))
+        entry = rel(record["path"])
+        run.files.append(FileRecord(package, entry, group, record["findings"], record["error"]))
+        for item in (next(items) for _ in range(record["findings"])):
+            run.findings.append(Finding(package, rel(item["path"]), entry, group, item["rule"], item["severity"],
+                                        int(item.get("line") or 0), item["message"]))
 
 
 def load_run(path: Path) -> Run:
@@ -294,11 +297,15 @@ def message_digest(message: str) -> str:
 
 
 def assign_keys(findings: list[Finding], seed: int) -> None:
-    """``PACKAGE/PATH:LINE:RULE:DIGEST``; a second finding with the same key gets ``#2`` (by message)."""
+    """``PACKAGE/PATH:LINE:RULE:DIGEST``, with ``@PACKAGE/ENTRY`` when the finding points into a file
+    the linted one includes (one finding per robot that uses the macro); a second finding with the same
+    key gets ``#2`` (ordered by message)."""
     seen: Counter[str] = Counter()
-    for finding in sorted(findings, key=lambda f: (f.file, f.line, f.rule, f.message)):
+    for finding in sorted(findings, key=lambda f: (f.file, f.entry, f.line, f.rule, f.message)):
         finding.digest = message_digest(finding.message)
         base = f"{finding.file}:{finding.line}:{finding.rule}:{finding.digest}"
+        if finding.entry != finding.file:
+            base += f"@{finding.entry}"
         seen[base] += 1
         finding.key = base if seen[base] == 1 else f"{base}#{seen[base]}"
         finding.rank = hashlib.sha1(f"{seed}:{finding.key}".encode()).hexdigest()
@@ -308,24 +315,34 @@ def sample_size(count: int, low: int, high: int) -> int:
     return min(count, max(low, min(high, math.ceil(math.sqrt(count)))))
 
 
+def allocate(counts: dict[str, int], order: list[str], wanted: int) -> dict[str, int]:
+    """How many of a rule's ``wanted`` samples each package gets: one each first (in ``order``, for
+    variety), the rest in proportion to the package's findings (D'Hondt), never more than it has."""
+    share = {package: 0 for package in order}
+    for package in order[:wanted]:
+        share[package] = 1
+    for _ in range(wanted - sum(share.values())):
+        open_ = [p for p in order if share[p] < counts[p]]
+        best = max(open_, key=lambda p: (counts[p] / (share[p] + 1), -order.index(p)))
+        share[best] += 1
+    return share
+
+
 def mark_sample(findings: list[Finding], low: int, high: int) -> None:
-    """Per (group, rule): the lowest-ranked finding of each package in turn, the packages ordered by
-    their lowest rank, until the rule's sample size is reached."""
+    """Per (group, rule): :func:`allocate` the rule's sample size over its packages, then take each
+    package's lowest-ranked findings (the packages ordered by their lowest rank)."""
     by_rule: dict[tuple[str, str], list[Finding]] = defaultdict(list)
     for finding in findings:
         by_rule[(finding.group, finding.rule)].append(finding)
     for members in by_rule.values():
-        wanted = sample_size(len(members), low, high)
         queues: dict[str, list[Finding]] = defaultdict(list)
         for finding in sorted(members, key=lambda f: f.rank):
             queues[finding.package].append(finding)
-        order = sorted(queues.values(), key=lambda queue: queue[0].rank)
-        taken = 0
-        while taken < wanted:
-            for queue in order:
-                if queue and taken < wanted:
-                    queue.pop(0).sampled = True
-                    taken += 1
+        order = sorted(queues, key=lambda package: queues[package][0].rank)
+        share = allocate({p: len(q) for p, q in queues.items()}, order, sample_size(len(members), low, high))
+        for package, queue in queues.items():
+            for finding in queue[:share[package]]:
+                finding.sampled = True
 
 
 # --------------------------------------------------------------------------------------------
@@ -356,8 +373,8 @@ def match_verdicts(findings: list[Finding], verdicts: dict[str, dict[str, str]])
         if key in current:
             matched[key] = (verdict, key)
     for key in (k for k in verdicts if k not in current):
-        file, line, rule, digest = _split_key(key)
-        free = [f for f in findings if f.file == file and f.rule == rule and f.key not in matched]
+        file, entry, line, rule, digest = _split_key(key)
+        free = [f for f in findings if (f.file, f.entry, f.rule) == (file, entry, rule) and f.key not in matched]
         for candidates in ([f for f in free if f.digest == digest], [f for f in free if f.line == line]):
             if len(candidates) == 1:
                 matched[candidates[0].key] = (verdicts[key], key)
@@ -365,10 +382,11 @@ def match_verdicts(findings: list[Finding], verdicts: dict[str, dict[str, str]])
     return matched
 
 
-def _split_key(key: str) -> tuple[str, int, str, str]:
-    key = key.split("#", 1)[0]
+def _split_key(key: str) -> tuple[str, str, int, str, str]:
+    """(file, entry, line, rule, digest) of a key (``#N`` dropped)."""
+    key, _, entry = key.split("#", 1)[0].partition("@")
     file, line, rule, digest = key.rsplit(":", 3)
-    return file, int(line), rule, digest
+    return file, entry or file, int(line), rule, digest
 
 
 # --------------------------------------------------------------------------------------------
@@ -377,33 +395,43 @@ def _split_key(key: str) -> tuple[str, int, str, str]:
 
 @dataclass
 class Row:
+    """One rule at one severity: its findings, and the verdicts of its sample, per package."""
+
     rule: str
     severity: str
-    findings: int = 0
     files: set[str] = field(default_factory=set)
-    counts: Counter[str] = field(default_factory=Counter)  # verdict -> judged findings
+    findings: Counter[str] = field(default_factory=Counter)  # package -> findings
+    judged: dict[str, Counter[str]] = field(default_factory=lambda: defaultdict(Counter))  # package -> verdicts
 
     @property
-    def judged(self) -> int:
-        return sum(self.counts.values())
+    def total(self) -> int:
+        return sum(self.findings.values())
 
     @property
-    def false_rate(self) -> float | None:
-        return self.counts["false"] / self.judged if self.judged else None
+    def counts(self) -> Counter[str]:
+        return sum(self.judged.values(), Counter())
 
-    @property
-    def benign_rate(self) -> float | None:
-        return self.counts["benign"] / self.judged if self.judged else None
+    def estimate(self, verdict: str) -> float | None:
+        """Findings of the rule estimated to have ``verdict``: each package's findings times its
+        sample's rate (stratified; a package without a judged sample takes the rule's pooled rate)."""
+        pooled = self.counts
+        if not sum(pooled.values()):
+            return None
+        total = 0.0
+        for package, count in self.findings.items():
+            verdicts = self.judged.get(package) or pooled
+            total += count * verdicts[verdict] / sum(verdicts.values())
+        return total
 
 
 def rows_of(findings: Iterable[Finding], matched: Matched) -> list[Row]:
     rows: dict[tuple[str, str], Row] = {}
     for finding in findings:
         row = rows.setdefault((finding.rule, finding.severity), Row(finding.rule, finding.severity))
-        row.findings += 1
-        row.files.add(finding.file)
+        row.findings[finding.package] += 1
+        row.files.add(finding.entry)
         if finding.sampled and finding.key in matched:
-            row.counts[matched[finding.key][0]["verdict"]] += 1
+            row.judged[finding.package][matched[finding.key][0]["verdict"]] += 1
     return sorted(rows.values(), key=lambda r: (SEVERITIES.index(r.severity), r.rule))
 
 
@@ -412,15 +440,19 @@ def _pct(value: float | None) -> str:
 
 
 def table(rows: list[Row]) -> Iterator[str]:
-    yield "| rule | severity | findings | files | judged | true | benign | false | false % (sample) |"
-    yield "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
+    yield "| rule | severity | findings | files | judged | true | benign | false | false % (sample) | est. false |"
+    yield "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
     for row in rows:
-        yield (f"| {row.rule} | {row.severity} | {row.findings} | {len(row.files)} | {row.judged} | "
-               f"{row.counts['true']} | {row.counts['benign']} | {row.counts['false']} | {_pct(row.false_rate)} |")
+        counts = row.counts
+        judged = sum(counts.values())
+        estimate = row.estimate("false")
+        yield (f"| {row.rule} | {row.severity} | {row.total} | {len(row.files)} | {judged} | {counts['true']} | "
+               f"{counts['benign']} | {counts['false']} | {_pct(counts['false'] / judged if judged else None)} | "
+               f"{'-' if estimate is None else f'{estimate:.0f}'} |")
 
 
 def totals(rows: list[Row]) -> Iterator[str]:
-    """Per severity: the sample's counts, and each rule's sampled rates scaled to its findings."""
+    """Per severity: the sample's counts, and the estimated false and benign findings of all findings."""
     yield ("| severity | findings | judged | true | benign | false | false % (sample) | est. false | est. false % "
            "| est. benign % |")
     yield "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
@@ -428,12 +460,12 @@ def totals(rows: list[Row]) -> Iterator[str]:
         members = [r for r in rows if r.severity == severity]
         if not members:
             continue
-        findings = sum(r.findings for r in members)
+        findings = sum(r.total for r in members)
         counts: Counter[str] = sum((r.counts for r in members), Counter())
         judged = sum(counts.values())
-        unjudged = sum(r.findings for r in members if not r.judged)
-        est_false = sum(r.findings * r.false_rate for r in members if r.false_rate is not None)
-        est_benign = sum(r.findings * r.benign_rate for r in members if r.benign_rate is not None)
+        unjudged = sum(r.total for r in members if r.estimate("false") is None)
+        est_false = sum(r.estimate("false") or 0.0 for r in members)
+        est_benign = sum(r.estimate("benign") or 0.0 for r in members)
         base = findings - unjudged
         note = f" ({unjudged} in unjudged rules)" if unjudged else ""
         yield (f"| {severity} | {findings}{note} | {judged} | {counts['true']} | {counts['benign']} | "
@@ -506,7 +538,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--ar3cli", metavar="PATH", help="an ar3cli executable (default: this checkout's sources)")
     parser.add_argument("--seed", type=int, default=35, help="sampling seed (default 35)")
     parser.add_argument("--min-per-rule", type=int, default=5)
-    parser.add_argument("--max-per-rule", type=int, default=15)
+    parser.add_argument("--max-per-rule", type=int, default=25)
     parser.add_argument("--only", metavar="NAMES", help="only these packages (comma-separated)")
     parser.add_argument("--json-out", type=Path, help="write every finding (with key and sample flag) here")
     parser.add_argument("--from-json", type=Path, help="reuse a --json-out file instead of linting")
