@@ -63,6 +63,7 @@ DEFAULT_CACHE = Path("~/.cache/ar3cli-quiet").expanduser()
 DEFAULT_CORPUS = HERE / "quietness_corpus.txt"
 DEFAULT_VERDICTS = HERE / "quietness_verdicts.json"
 ROBOT_SUFFIXES = (".urdf", ".xacro")
+MESH_SUFFIXES = (".stl", ".obj", ".dae", ".glb", ".gltf", ".ply", ".mesh")
 SKIP_DIRS = {".git", ".hg", ".svn", "__pycache__", "node_modules", ".venv", "venv", ".tox"}
 XACRO_NAMESPACES = ("http://www.ros.org/wiki/xacro", "http://ros.org/wiki/xacro", "http://wiki.ros.org/xacro")
 XACRO_KEYWORDS = {"macro", "property", "include", "arg", "if", "unless", "insert_block", "element",
@@ -158,6 +159,12 @@ def robot_files(folder: Path) -> list[Path]:
     return found
 
 
+def mesh_files(folder: Path) -> Iterator[Path]:
+    """The package's mesh files (by suffix, any case): the corpus table's size of each package."""
+    for dirpath, _dirnames, filenames in os.walk(folder):
+        yield from (Path(dirpath) / name for name in filenames if name.lower().endswith(MESH_SUFFIXES))
+
+
 def is_macro_only(path: Path) -> bool:
     """A xacro file whose top level makes no link: no <link>, no macro call (macros, properties,
     includes, args, materials and the like only). A file that does not parse is an entry point."""
@@ -250,7 +257,8 @@ def lint_corpus(args: argparse.Namespace, pins: list[Pin]) -> Run:
             folder = fetch(pin, args.cache)
             files = robot_files(folder)
             groups = {"entry": [f for f in files if not is_macro_only(f)], "macro": [f for f in files if is_macro_only(f)]}
-            run.packages[pin.name] = {"version": pin.version, "entry": len(groups["entry"]), "macro": len(groups["macro"])}
+            run.packages[pin.name] = {"version": pin.version, "entry": len(groups["entry"]), "macro": len(groups["macro"]),
+                                      "meshes": sum(1 for _ in mesh_files(folder))}
             for group, paths in groups.items():
                 if paths:
                     _lint_group(run, command, env, scratch, pin.name, folder, group, paths)
@@ -494,11 +502,12 @@ def classes(findings: list[Finding], matched: Matched) -> Iterator[str]:
 def report(run: Run, verdicts: dict[str, dict[str, str]], verdict_path: Path) -> tuple[list[str], list[Finding]]:
     matched = match_verdicts(run.findings, verdicts)
     out = ["# Quietness of lint-urdf", "", "Command: `" + " ".join(run.command) + " FILE...` (per package and group)", ""]
-    out += ["| package | version | entry points | macro-only |", "| --- | --- | ---: | ---: |"]
-    out += [f"| {name} | {p['version']} | {p['entry']} | {p['macro']} |" for name, p in sorted(run.packages.items())]
-    entry_total = sum(int(p["entry"]) for p in run.packages.values())
-    macro_total = sum(int(p["macro"]) for p in run.packages.values())
-    out += [f"| **{len(run.packages)} packages** | | **{entry_total}** | **{macro_total}** |", ""]
+    out += ["| package | version | entry points | macro-only | mesh files |", "| --- | --- | ---: | ---: | ---: |"]
+    out += [f"| {name} | {p['version']} | {p['entry']} | {p['macro']} | {p.get('meshes', '-')} |"
+            for name, p in sorted(run.packages.items())]
+    total = {column: sum(int(p.get(column, 0)) for p in run.packages.values()) for column in ("entry", "macro", "meshes")}
+    out += [f"| **{len(run.packages)} packages** | | **{total['entry']}** | **{total['macro']}** | "
+            f"**{total['meshes']}** |", ""]
     failed = [f for f in run.files if f.error]
     if failed:
         out += [f"Files lint-urdf could not check: {len(failed)}"] + [f"- {f.file}: {f.error}" for f in failed] + [""]
