@@ -72,6 +72,9 @@ XACRO_KEYWORDS = {"macro", "property", "include", "arg", "if", "unless", "insert
 XACRO_BLOCKS = {"if", "unless"}
 """xacro elements whose content is output in place (looked into when classifying a file)."""
 VERDICTS = ("true", "benign", "false")
+SIM_FAMILIES = {"P", "M"}
+"""Rule families that only a --sim run (and, for M, --engine mujoco/all) produces: their verdicts are
+not 'gone' from a run without them."""
 SEVERITIES = ("error", "warning", "info")
 GROUPS = ("entry", "macro")
 GROUP_TITLES = {"entry": "Entry points", "macro": "Macro-only xacro files"}
@@ -527,7 +530,9 @@ def report(run: Run, verdicts: dict[str, dict[str, str]], verdict_path: Path) ->
         out += [f"Verdicts carried to a moved or reworded finding: {len(carried)} (check them)", ""]
         out += [f"- `{source}` -> `{key}`" for key, source in carried] + [""]
     used = {source for _, source in matched.values()}
-    gone = [key for key in verdicts if key not in used]
+    families = {f.rule[0] for f in run.findings}
+    gone = [key for key in verdicts if key not in used
+            and (_split_key(key)[3][0] in families or _split_key(key)[3][0] not in SIM_FAMILIES)]
     if gone:
         out += [f"Verdicts of {verdict_path.name} whose finding is gone: {len(gone)}", ""]
     unjudged = [f for f in run.findings if f.sampled and f.key not in matched]
