@@ -3,7 +3,7 @@
 1. **Corpus.** Every ``NAME==VERSION`` of ``benchmarks/quietness_corpus.txt`` (``--corpus``) is
    fetched with ``pip download --no-deps --only-binary=:all:`` into ``<cache>/wheels`` and unpacked
    into ``<cache>/pkgs/NAME`` (``--cache``, default ``~/.cache/ar3cli-quiet``); what is there already
-   is reused, so only the first run downloads (about 560 MB). Nothing is written inside the repository.
+   is reused, so only the first run downloads (about 520 MB; 1.6 GB unpacked). Nothing is written inside the repository.
 2. **Lint.** Every ``*.urdf`` / ``*.xacro`` of a package (lint-urdf's own folder search) is an
    *entry point*, except xacro files that only define macros, properties or materials for others to
    include (nothing at their top level makes a link: no ``<link>``, no macro call). Those are the

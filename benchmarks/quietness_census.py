@@ -80,11 +80,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--cache", type=Path, default=DEFAULT_CACHE, help="quietness.py's --cache")
     args = parser.parse_args(argv)
     counts = census(json.loads(args.run.read_text(encoding="utf-8")), args.cache.expanduser())
-    print(f"G008: {counts['G008 marker']} of {counts['G008 read']} findings (in files ar3cli reads; "
-          f"{counts['G008 skipped']} skipped) are on links whose only visuals are boxes/spheres of "
-          f"{MARKER_SIZE * 100:g} cm or less")
-    print(f"J008: {counts['J008 follower']} of {counts['J008 read']} findings ({counts['J008 skipped']} skipped) "
-          "are on <mimic> followers")
+    print(f"G008: {counts['G008 marker']} of {counts['G008 read']} findings ({counts['G008 skipped']} in files "
+          f"that could not be read) are on links whose only visuals are boxes/spheres of {MARKER_SIZE * 100:g} cm or less")
+    print(f"J008: {counts['J008 follower']} of {counts['J008 read']} findings ({counts['J008 skipped']} in files "
+          "that could not be read) are on <mimic> followers")
     return 0
 
 
