@@ -15,10 +15,14 @@ class Context:
     """The model a rule checks, with the link boxes and the PyBullet session built once per file
     and shared by every rule that asks (pybullet is imported only when a ``--sim`` rule does)."""
 
-    def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset()) -> None:
+    def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset(),
+                 targets: tuple[str, ...] = ("pybullet", "ros")) -> None:
         self.model = model
         self.srdf_disabled = srdf_disabled
         """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf_read.is_disabled`)."""
+        self.targets = targets
+        """The engines the robot is meant for (``lint-urdf --target``): a rule whose verdict depends on
+        the engine (a mesh MuJoCo finds through its own ``meshdir``) asks here."""
         self._bounds: dict[str, Box | None] = {}
         self._shape_bounds: dict[int, Box | None] = {}
         self._mesh_bounds: dict[tuple, Box | None] = {}

@@ -208,7 +208,7 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
 
     return ResultCache.for_settings(rules=[rule.code for rule in rules], per_file_ignores=options.per_file_ignores,
                                     severity=options.severity, package_paths=options.package_paths,
-                                    xacro_args=options.xacro_args)
+                                    xacro_args=options.xacro_args, targets=options.targets)
 
 
 def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: ResultCache | None = None) -> LintResult:
@@ -286,7 +286,7 @@ _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]]
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
     """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
-    context = Context(model, options.srdf_disabled)
+    context = Context(model, options.srdf_disabled, options.targets)
     locator = Locator(model, shown)
     file_ignores = _file_level_ignores(model.source_bytes)
     findings: list[Finding] = []
@@ -302,8 +302,8 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> li
                 path, line, column = locator.locate(hit)
                 if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
                     continue
-                findings.append(_override(Finding(rule.code, rule.severity, hit.message, path, line, column,
-                                                  hit.hint or rule.fix), options))
+                findings.append(_override(Finding(rule.code, rule.severity_for(options.targets), hit.message, path, line,
+                                                  column, hit.hint or rule.fix), options))
     finally:
         context.close()
     return findings

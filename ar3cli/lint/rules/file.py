@@ -11,6 +11,7 @@ from ar3cli.lint.rules.base import Hit, engine_rule, robot, rule
 
 unreadable = engine_rule(
     "F001", "unreadable", "error", "File cannot be read",
+    breaks="No engine or tool can read the file: nothing else is checked.",
     why="The path is missing, a directory, a pipe or device, too large, or not readable; nothing else can "
         "be checked.",
     fix="Check the path and its permissions.",
@@ -18,6 +19,7 @@ unreadable = engine_rule(
 
 not_xml = engine_rule(
     "F002", "not-xml", "error", "File is not well-formed XML",
+    breaks="urdfdom, PyBullet, MuJoCo and every XML parser refuse the file.",
     why="Every URDF consumer parses XML first; a syntax error (or an empty file, binary junk, or an "
         "entity declaration, which ar3cli refuses because entities can explode or read other files) "
         "stops all of them.",
@@ -27,6 +29,7 @@ not_xml = engine_rule(
 
 not_robot = engine_rule(
     "F003", "not-robot", "error", "Root element is not <robot>",
+    breaks="urdfdom and PyBullet refuse a file whose root element is not <robot>.",
     why="A URDF's root element must be <robot>; an SDF, MJCF or other XML file is not a URDF.",
     fix="Lint only URDF files, or convert the file to URDF.",
     bad='<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>',
@@ -34,6 +37,7 @@ not_robot = engine_rule(
 
 xacro_failed = engine_rule(
     "F004", "xacro-failed", "error", "Xacro expansion failed",
+    breaks="xacro stops: no URDF comes out for any tool.",
     why="A .xacro file must expand before it can be checked; undefined properties, missing includes "
         "or unknown packages stop the expansion.",
     fix="Pass --xacro-arg NAME:=VALUE / --package-path NAME=DIR, or fix the xacro at the reported place.",
@@ -46,6 +50,7 @@ _PORTABILITY_QUIRKS = ("version-", "leading-junk", "trailing-junk", "undeclared-
 
 
 @rule("F005", "strict-parser", "warning", "File needs a tolerant XML parser",
+      engines=("ros",),
       why="""Strict parsers (urdfdom's TinyXML2, Python's xml.etree, ROS tools) reject
       version="0.0" declarations, blank lines or junk before the declaration, and bytes after the
       root element; namespace-aware ones (lxml, ROS 2 launch, xacro) reject an element prefix that
@@ -67,6 +72,9 @@ _SUBSTITUTION = re.compile(r"\$\(|\$\{")
 
 
 @rule("F006", "unexpanded-substitution", "error", "Unexpanded $(...) or ${...} substitution",
+      refused_by=("ros", "pybullet"),
+      breaks="Every parser reads the text literally: urdfdom refuses a substituted number, and PyBullet cannot "
+             "find a substituted mesh path and refuses the file.",
       why="""A URDF containing $(find pkg) or ${var} was written from a xacro file without
       expanding it (or by a broken generator); every URDF parser reads the text literally, so
       mesh paths and numbers are wrong.""",
@@ -135,6 +143,8 @@ def number_problem(text: str, count: int) -> str | None:
 
 
 @rule("F007", "malformed-number", "error", "Malformed number or wrong number of components",
+      refused_by=("ros",),
+      breaks="urdfdom refuses the file; PyBullet silently reads zeros, and nan or inf become NaN states.",
       why="""xyz/rpy/size/scale need exactly three numbers, rgba four, masses and limits one.
       Parsers disagree on what to do with "0 0" or "1,0,0": urdfdom refuses the file, PyBullet
       silently reads zeros, and nan or inf propagate into the physics as NaN states.""",

@@ -51,6 +51,9 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
 
 
 @rule("G001", "mesh-not-found", "error", "Mesh file not found",
+      refused_by=("pybullet", "mujoco"),
+      breaks='PyBullet refuses the file ("Cannot load URDF file"); RViz and MoveIt draw and collide nothing for '
+             "the link.",
       why="""PyBullet refuses the whole file with "Cannot load URDF file" (the real reason, the missing
       mesh, only goes to C stdout); RViz shows nothing. ar3cli resolves package:// like ROS
       (--package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, package.xml in ancestors) and relative
@@ -67,6 +70,7 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
 
 
 @rule("G002", "empty-package", "error", "package:/// URI with an empty package name",
+      engines=("ros",), breaks="ROS (RViz, MoveIt, Gazebo) cannot resolve the URI: the link has no mesh there.",
       why="""package:///meshes/x.stl has an empty package name (three slashes). ROS cannot resolve it;
       PyBullet only finds the file by its fallback search relative to the URDF.""",
       fix="Write package://PACKAGE_NAME/meshes/x.stl, or a path relative to the URDF.",
@@ -91,6 +95,9 @@ def absolute_path(ctx) -> Iterator[Hit]:
 
 
 @rule("G004", "mesh-format", "error", "Mesh format PyBullet cannot load",
+      engines=("pybullet", "mujoco"),
+      refused_by=("pybullet", "mujoco"),
+      breaks='PyBullet refuses the file ("invalid mesh filename extension"); MuJoCo cannot read the mesh either.',
       why="""PyBullet loads .stl, .obj and .dae meshes only; a .ply or Ogre .mesh makes it refuse the
       whole file ("invalid mesh filename extension").""",
       fix="Convert the mesh to .stl or .obj (e.g. with trimesh or MeshLab).",
@@ -106,6 +113,7 @@ def mesh_format(ctx) -> Iterator[Hit]:
 
 
 @rule("G005", "lfs-pointer", "error", "Mesh is a Git LFS pointer file",
+      breaks="Every mesh loader gets a 130-byte text file: PyBullet reports a corrupt or empty mesh.",
       why="""The repository stores meshes in Git LFS and they were never pulled: the file is a
       130-byte text pointer. Loaders report a corrupt or empty mesh, or crash.""",
       fix="Run git lfs install && git lfs pull in the repository.",
@@ -160,6 +168,7 @@ def mesh_units(ctx) -> Iterator[Hit]:
 
 
 @rule("G007", "scalar-scale", "warning", "Mesh scale is a single number",
+      engines=("ros",),
       why="""The spec's scale is three numbers. PyBullet accepts one (with "Scale should be a
       vector3"), urdfdom and yourdfpy refuse or misread it.""",
       fix='Repeat it: scale="0.001 0.001 0.001".',
@@ -187,6 +196,7 @@ def no_collision(ctx) -> Iterator[Hit]:
 
 
 @rule("G009", "pybullet-only-path", "info", "Mesh found only by PyBullet's fallback search",
+      engines=("ros",),
       why="""The mesh resolves only because PyBullet also looks for package://NAME/x relative to the
       URDF and in every folder above it. ROS (RViz, MoveIt, Gazebo) resolves package://NAME through
       the package index and will not find it.""",
@@ -281,6 +291,9 @@ def _found_meshes(ctx):
 
 
 @rule("G011", "mesh-unreadable", "error", "Mesh file that engines cannot read",
+      engines=("pybullet", "mujoco"),
+      refused_by=("mujoco",),
+      breaks='PyBullet silently drops the shape ("cannot extract mesh", measured); MuJoCo refuses the file.',
       why="""Judged by the file's bytes, not its name. PyBullet reads binary STL only: an ASCII STL,
       a truncated binary STL or one with no triangles loads without the shape ("cannot extract
       mesh", measured with pybullet 3.2.7: the link has no collision and no visual), and MuJoCo
@@ -360,6 +373,7 @@ def mesh_flat(ctx) -> Iterator[Hit]:
 
 
 @rule("G013", "hull-much-larger", "info", "Collision mesh much smaller than its convex hull",
+      engines=("pybullet", "mujoco", "drake"),
       why="""PyBullet (for every moving body), MuJoCo and Drake's point contact collide a mesh as
       its convex hull. A concave part (a gripper's U, a hollow housing, two fingers in one file)
       whose hull is more than twice its volume collides as the filled-in shape: fingers cannot

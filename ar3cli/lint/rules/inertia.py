@@ -71,6 +71,9 @@ def _fmt(moments) -> str:
 
 
 @rule("I001", "inertial-missing", "error", "Moving link without <inertial>",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      breaks="PyBullet simulates the link as 1 kg with I = 1 (measured), MuJoCo invents its mass from the "
+             "geometry at water density, Gazebo drops the link.",
       why="""PyBullet gives a link without <inertial> a mass of 1 kg and an inertia of (1, 1, 1),
       silently apart from a C-level warning. On a small arm that is kilograms of phantom mass at
       the wrist; MuJoCo instead computes it from the geometry at water density.""",
@@ -87,6 +90,7 @@ def inertial_missing(ctx) -> Iterator[Hit]:
 
 
 @rule("I002", "fixed-link-inertial-missing", "warning", "Link on a fixed joint without <inertial>",
+      engines=("pybullet",),
       why="""A frame link (tool tip, sensor frame) hangs from a fixed joint and often has neither
       geometry nor <inertial>. PyBullet still gives it 1 kg and I = 1, so every tcp/camera frame adds
       a kilogram to the arm's end.""",
@@ -110,6 +114,9 @@ def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
 
 
 @rule("I003", "mass-not-positive", "error", "Mass missing, zero or negative on a moving link",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks="PyBullet makes a mass-0 link static and diverges on a negative mass; MuJoCo refuses the file.",
       why="""A moving body needs positive mass. PyBullet treats mass 0 as static (the link stops
       following the physics), negative mass makes the dynamics diverge, and MuJoCo refuses both.""",
       fix="Set the link's real mass in kg.",
@@ -141,6 +148,10 @@ def _tensor_hits(ctx, test):
 
 
 @rule("I004", "inertia-not-positive-definite", "error", "Inertia tensor is not positive definite",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks="MuJoCo refuses the body and Drake substitutes the tensor; PyBullet loaded with "
+             "URDF_USE_INERTIA_FROM_FILE drifts or explodes.",
       why="""Every principal moment of a real body is positive. A zero or negative one makes the
       mass matrix singular or indefinite: PyBullet warns and the simulation drifts or explodes,
       MuJoCo and Drake refuse or substitute the tensor. Tensors that are zero apart from rounding
@@ -156,6 +167,10 @@ def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
 
 
 @rule("I005", "inertia-triangle", "error", "Inertia violates the triangle inequality",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks='MuJoCo refuses the file ("inertia must satisfy A + B >= C"); PyBullet simulates a body that cannot '
+             "exist.",
       why="""For a real body each principal moment is at most the sum of the other two
       (A + B >= C). A tensor that breaks it cannot belong to any mass distribution; MuJoCo refuses
       it ("inertia must satisfy A + B >= C") and PyBullet simulates a body that cannot exist.""",
@@ -198,6 +213,10 @@ _ZERO_TENSOR = '<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy=
 
 
 @rule("I006", "inertia-zero", "error", "Zero or missing inertia tensor with positive mass on a moving link",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks="MuJoCo refuses the moving body (moments below mjMINVAL) and PyBullet loaded with "
+             "URDF_USE_INERTIA_FROM_FILE divides by the zero moments.",
       why="""A body with mass but no rotational inertia (ixx = iyy = izz = 0, moments below 1e-15 that
       are zero written with rounding noise, or no <inertia>) is a point mass. On a link that moves
       (or on the root, which floats unless fixed by the loader) PyBullet divides by the zero moments
@@ -236,6 +255,10 @@ def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
 
 
 @rule("I009", "inertia-near-singular", "error", "Near-singular inertia tensor on a moving link",
+      engines=("mujoco", "pybullet", "drake"),
+      refused_by=("mujoco",),
+      breaks="MuJoCo refuses the body (a moment below mjMINVAL); every solver that inverts the tensor meets a "
+             "condition number above 1e9.",
       why="""A principal moment below MuJoCo's mjMINVAL (1e-15 kg·m²) makes MuJoCo refuse a moving
       body ("mass and inertia of moving bodies must be larger than mjMINVAL"; (2.2e-18, 0.215,
       0.215) is refused). A moment below 1e-9 of the largest belongs to no real body (a rod's ratio
@@ -299,6 +322,7 @@ def inertia_implausible(ctx) -> Iterator[Hit]:
 
 
 @rule("I010", "mass-zero-with-inertia", "info", "Mass 0 with a non-zero inertia tensor",
+      engines=("drake",),
       why="""mass 0 with a non-zero tensor contradicts itself. PyBullet reads it as the author
       meant: a mass-0 root is static (its idiom for tables and planes) and a mass-0 link on a fixed
       joint adds nothing; MuJoCo's URDF import fixes the root to the world and merges fixed links,
@@ -328,6 +352,7 @@ def mass_zero_with_inertia(ctx) -> Iterator[Hit]:
 
 
 @rule("I011", "world-inertial", "warning", "<inertial> on the link named 'world'",
+      engines=("drake", "ros", "pybullet"),
       why="""A link named "world" is the world itself in Drake, MuJoCo and Gazebo, not a body:
       Drake ignores its <inertial> with a warning, KDL (robot_state_publisher, MoveIt) cannot give
       the root link an inertia and ignores it too. PyBullet alone uses it: with useFixedBase=False the
@@ -352,6 +377,7 @@ def _looks_like_frame(link) -> bool:
 
 
 @rule("I012", "root-inertial-missing", "info", "Root link with geometry but no <inertial>",
+      engines=("pybullet", "drake"),
       why="""This matters only if the robot floats (a mobile base, a legged robot, an object to
       grasp); most arms are loaded with a fixed base and can ignore it. Loaded with
       useFixedBase=False, PyBullet gives a root without <inertial> 1 kg and I = (1, 1, 1), silently

@@ -37,6 +37,7 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
 
 
 @rule("M001", "mujoco-compile-failed", "error", "MuJoCo refuses to compile the model",
+      engines=("mujoco",), refused_by=("mujoco",), breaks="MuJoCo refuses the file (measured: ar3cli compiles it).",
       why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
       PyBullet's loader: a moving body whose mass or inertia is below mjMINVAL (a link without <inertial>
       and without collision geometry), an inertia breaking A + B >= C, a zero joint axis. ar3cli quotes
@@ -63,6 +64,7 @@ _STL = robot(f"""
 
 
 @rule("M002", "mujoco-mesh-unreadable", "warning", "A collision mesh MuJoCo cannot read",
+      engines=("mujoco",),
       why="""MuJoCo reads STL, OBJ and MSH meshes only: a COLLADA (.dae) collision mesh, or one that is not found,
       stops its whole compile with "Error opening file". ar3cli replaces the mesh by its bounding box (or leaves
       it out when its size is unknown) so the other checks still run, and says so here.""",
@@ -78,6 +80,7 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
 
 
 @rule("M003", "mujoco-self-collision-home", "warning", "Links collide in MuJoCo at the home pose",
+      engines=("mujoco",),
       why="""MuJoCo collides every pair of bodies but a parent and its child (no URDF_USE_SELF_COLLISION flag
       to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
       starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
@@ -118,6 +121,7 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
 
 
 @rule("M004", "mujoco-unstable", "error", "NaN or exploding states in MuJoCo after 1 s under gravity",
+      engines=("mujoco",), breaks="MuJoCo's joint states become NaN or explode within one simulated second (measured).",
       why="""ar3cli compiles the model (root welded to the world), puts it at the home pose and simulates one
       second under gravity with MuJoCo's default timestep (2 ms). A real robot falls limp; NaN positions,
       MuJoCo's own instability warning (mjWARN_BADQACC) or joint speeds above 100 rad/s mean an inertia too

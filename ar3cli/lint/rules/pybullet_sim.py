@@ -48,6 +48,7 @@ def _home(body) -> dict[str, float] | None:
 
 
 @rule("P001", "sim-load-failed", "error", "PyBullet cannot load the model",
+      engines=("pybullet",), refused_by=("pybullet",), breaks="PyBullet refuses the file (measured: ar3cli loads it).",
       why="""What matters in the end is whether the simulator accepts the file. PyBullet's own error is
       "Cannot load URDF file."; ar3cli captures its C output and reports the real reason (a missing
       mesh, a joint without limits, ...).""",
@@ -75,6 +76,7 @@ def _stacked_boxes(tip_z: float) -> str:
 
 
 @rule("P002", "sim-self-collision-home", "warning", "Links collide at the home pose",
+      engines=("pybullet",),
       why="""Two links that are not adjacent but interpenetrate (deeper than 1 µm) at the home pose
       (all joints at 0, or mid-range where 0 is outside the limits; mimic joints following) mean
       overlapping collision meshes or a wrong joint origin. With self-collision on, PyBullet pushes
@@ -113,6 +115,7 @@ def _depth_text(depth: float) -> str:
 
 
 @rule("P003", "sim-inertia-differs", "info", "PyBullet uses a different mass or inertia than the file",
+      engines=("pybullet",),
       why="""By default (no URDF_USE_INERTIA_FROM_FILE flag) PyBullet keeps the file's mass but
       recomputes every inertia tensor from the collision shape's bounding box, padded by the
       collision margin. Code that loads with default flags simulates these values, not the file's.""",
@@ -167,6 +170,8 @@ def _differs(used: float, declared: float) -> bool:
 
 
 @rule("P004", "sim-unstable", "error", "NaN or exploding states after settling under gravity",
+      engines=("pybullet",),
+      breaks="PyBullet's joint states become NaN or explode within one simulated second (measured).",
       why="""ar3cli loads the model (fixed base, inertia from the file), puts it at the home pose,
       turns off PyBullet's default joint motors and simulates one second under gravity. A real
       robot falls limp; NaN positions or joint speeds above 100 rad/s mean an unphysical inertia,
@@ -203,6 +208,7 @@ def _swinging_arm(limit: float) -> str:
 
 
 @rule("P005", "sim-passes-through-parent", "warning", "A part passes through its parent when its joint moves",
+      engines=("pybullet",),
       why="""PyBullet never tests a link against its direct parent for self-collision and MoveIt calls
       the pair adjacent, so a child that swings through its parent's body is seen by no other check,
       and the robot's planners happily command poses the real robot cannot reach. ar3cli sweeps each

@@ -245,6 +245,9 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
 
 
 @rule("S018", "attribute-as-element", "error", "Attribute written as a child element",
+      refused_by=("ros", "pybullet"),
+      breaks="urdfdom and PyBullet refuse a <limit> whose required value is written only as an element; every "
+             "engine silently drops a damping or friction written so (Drake #18796).",
       why="""<dynamics><damping>5</damping></dynamics> and <limit><effort>10</effort></limit> look
       right but URDF values are attributes: urdfdom, PyBullet and MuJoCo read damping="..." and
       never look at a child element, so the joint gets no damping (Drake #18796); a <limit> whose
@@ -275,6 +278,10 @@ parseInertial: "Inertial element must have a mass element", "... inertia element
 
 
 @rule("S019", "missing-required-child", "error", "<visual>/<collision> without <geometry>, <inertial> without <mass>",
+      engines=("ros", "pybullet", "isaac"),
+      refused_by=("ros", "pybullet", "isaac"),
+      breaks="urdfdom refuses the link and the file, PyBullet fails to parse the link, Isaac Sim's importer "
+             "fails (IsaacSim #599).",
       why="""urdfdom refuses a <visual> or <collision> without <geometry> and an <inertial> without
       <mass> or <inertia>, and with it the whole file ("failed to parse link"); Isaac Sim's importer
       fails the same way with no location (IsaacSim #599); PyBullet's --sim load says only "failed to
@@ -306,6 +313,7 @@ VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
 
 
 @rule("S020", "undeclared-urdf-version", "info", "URDF 1.1/1.2 attribute in a file that does not declare it",
+      engines=("ros",),
       why="""<origin quat_xyzw> is URDF 1.1, acceleration/deceleration/jerk on <limit> URDF 1.2. In a
       file without <robot version="1.1"> (or "1.2") urdfdom 5.1+ ignores them (a quat_xyzw frame stays
       unrotated for ROS tools while ar3cli, which reads it, rotates it), and older urdfdom does not know

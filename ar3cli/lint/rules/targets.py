@@ -11,10 +11,10 @@ from collections import deque
 from collections.abc import Iterator
 from pathlib import PurePosixPath
 
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.base import ENGINES, LINK_INERTIAL, Hit, arm, robot, rule
 
-TARGETS = ("pybullet", "ros", "mujoco", "isaac", "drake", "gazebo")
-"""Engines ``--target`` accepts."""
+TARGETS = ENGINES
+"""Engines ``--target`` accepts: the ones a rule can be about."""
 DEFAULT_TARGETS = ("pybullet", "ros")
 
 _MIMIC = arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/>').replace(
