@@ -68,7 +68,9 @@ def strict_parser(ctx) -> Iterator[Hit]:
             yield Hit(quirk.message, line=quirk.line, hint=hint)
 
 
-_SUBSTITUTION = re.compile(r"\$\(|\$\{")
+SUBSTITUTION = re.compile(r"\$\(|\$\{")
+"""An unexpanded xacro or roslaunch substitution: ``$(find pkg)``, ``${var}`` (F006's; the mesh rules leave
+such paths alone, and F007 such numbers)."""
 
 
 @rule("F006", "unexpanded-substitution", "error", "Unexpanded $(...) or ${...} substitution",
@@ -89,9 +91,22 @@ def unexpanded_substitution(ctx) -> Iterator[Hit]:
         if not isinstance(element.tag, str):
             continue
         for key, value in element.attrib.items():
-            if _SUBSTITUTION.search(value):
-                yield Hit(f"<{element.tag} {key}=\"{value}\"> contains an unexpanded substitution", element,
+            if SUBSTITUTION.search(value):
+                consequence = (": no tool can find the mesh (PyBullet refuses the file)"
+                               if element.tag == "mesh" and key == "filename" else "")
+                yield Hit(f"<{qualified_name(element, element.tag)} {qualified_name(element, key)}=\"{value}\"> "
+                          f"contains an unexpanded substitution{consequence}", element,
                           hint=XACRO_SOURCE_HINT if xacro_source else None)
+
+
+def qualified_name(element, name: str) -> str:
+    """``name`` (a tag or an attribute of ``element``) as written, ``xacro:macro``, rather than lxml's Clark
+    notation ``{http://www.ros.org/wiki/xacro}macro``."""
+    if not name.startswith("{"):
+        return name
+    uri, _, local = name[1:].partition("}")
+    prefix = next((key for key, value in (element.nsmap or {}).items() if value == uri and key), None)
+    return f"{prefix}:{local}" if prefix else local
 
 
 XACRO_SOURCE_HINT = ("This file is a xacro source (it holds <xacro:...> elements): rename it to .xacro (or "
@@ -157,7 +172,7 @@ def malformed_number(ctx) -> Iterator[Hit]:
         found = []
         for key, text in element.items():  # the attributes written (one or two), not every one the spec has
             count = spec.get(key)
-            if count is None or ("$" in text and _SUBSTITUTION.search(text)):
+            if count is None or ("$" in text and SUBSTITUTION.search(text)):
                 continue  # unexpanded substitutions are F006's
             problem = number_problem(text, count)
             if problem:

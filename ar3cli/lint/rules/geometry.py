@@ -8,6 +8,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
+from ar3cli.lint.rules.file import SUBSTITUTION
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 
 MAX_PLAUSIBLE_EXTENT = 5.0
@@ -34,9 +35,11 @@ def _path_facts(name: str) -> tuple[bool, str]:
 
 
 def _meshes(ctx):
-    """(link, shape, geometry) for every mesh with a filename."""
+    """(link, shape, geometry) for every mesh with a filename; a filename holding an unexpanded
+    substitution (``$(find pkg)/x.stl``) is F006's alone: one cause, one finding."""
     for link, shape in ctx.model.meshes():
-        if shape.geometry.filename:
+        filename = shape.geometry.filename
+        if filename and not ("$" in filename and SUBSTITUTION.search(filename)):
             yield link, shape, shape.geometry
 
 
@@ -57,16 +60,43 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
       why="""PyBullet refuses the whole file with "Cannot load URDF file" (the real reason, the missing
       mesh, only goes to C stdout); RViz shows nothing. ar3cli resolves package:// like ROS
       (--package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, package.xml in ancestors) and relative
-      paths like PyBullet, and lists every place it looked.""",
+      paths like PyBullet, and lists every place it looked. MuJoCo looks elsewhere: in the
+      <mujoco><compiler meshdir> of the file, by the mesh's base name; for a robot meant for MuJoCo
+      only (--target mujoco) a mesh found there is not reported.""",
       fix="Fix the path, or tell ar3cli where the package is with --package-path NAME=DIR.",
-      bad=_mesh_robot("meshes/missing.stl"), good=_mesh_robot("meshes/base.stl"))
+      bad=_mesh_robot("meshes/missing.stl"), good=_mesh_robot("meshes/base.stl"),
+      references="MuJoCo src/xml/xml_urdf.cc (mesh file names stripped to their base name, looked up in "
+                 "<mujoco><compiler meshdir>).")
 def mesh_not_found(ctx) -> Iterator[Hit]:
+    meshdir = ctx.shared("mujoco-meshdir", mujoco_meshdir) if "mujoco" in ctx.targets else None
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
             tried = "; looked in " + ", ".join(resolution.tried) if resolution.tried else ""
-            yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{tried}",
+            also = ""
+            if meshdir is not None and ctx.model.resolver.is_file(meshdir / _base_name(resolution.uri)):
+                others = [target for target in ctx.targets if target != "mujoco"]
+                if not others:
+                    continue  # MuJoCo, the only target, finds it through its own meshdir
+                also = f" (only MuJoCo finds it, in its <compiler meshdir> {meshdir})"
+            yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{also}{tried}",
                       geometry.element)
+
+
+def mujoco_meshdir(model) -> Path | None:
+    """The folder MuJoCo looks for this file's meshes in: ``<mujoco><compiler meshdir="..."/>`` under
+    ``<robot>``, relative to the file's folder; None without one."""
+    for block in model.root.findall("mujoco"):
+        for compiler in block.findall("compiler"):
+            folder = compiler.get("meshdir")
+            if folder and folder.strip():
+                return model.resolver.base_dir / folder.strip()
+    return None
+
+
+def _base_name(uri: str) -> str:
+    """The mesh's file name as MuJoCo's URDF import keeps it: everything after the last slash."""
+    return uri.strip().replace("\\", "/").rsplit("/", 1)[-1]
 
 
 @rule("G002", "empty-package", "error", "package:/// URI with an empty package name",
@@ -83,14 +113,15 @@ def empty_package(ctx) -> Iterator[Hit]:
 
 
 @rule("G003", "absolute-path", "warning", "Absolute mesh path",
-      why="An absolute path (/home/me/... or file:///...) works on one machine only.",
+      why="""An absolute path (/home/me/... or file:///...) works on one machine only. file://meshes/x.stl
+      (two slashes) is not absolute: PyBullet and ar3cli read the rest as a path next to the URDF.""",
       fix="Use package://PACKAGE/... or a path relative to the URDF file.",
       bad=_mesh_robot("/home/me/robot/meshes/base.stl"), good=_mesh_robot("meshes/base.stl"),
       fixed_by="fix-mesh-paths --package NAME=DIR")
 def absolute_path(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         name = geometry.filename.strip()
-        if name.startswith("file://") or _path_facts(name)[0]:
+        if _path_facts(name.removeprefix("file://"))[0]:  # file:///a is /a; file://meshes/a is meshes/a
             yield Hit(f"link '{link.name}' mesh {name} is an absolute path", geometry.element)
 
 
@@ -181,18 +212,44 @@ def scalar_scale(ctx) -> Iterator[Hit]:
                       hint=f'Write scale="{text} {text} {text}".')
 
 
+MARKER_SIZE = 0.1
+"""A link whose visuals are smaller (box diagonal) than this fraction of the robot's median link is a
+marker (a sensor frame drawn as a 1 cm cube, pr2's and Talos' IMU boxes), not a part to collide with."""
+MARKER_MASS = 1e-3
+"""A link lighter than this fraction of the whole robot (or of mass 0) is a frame with a picture (Baxter's
+0.1 g display and camera links, a "nocol" marker sphere), not a body."""
+
+
 @rule("G008", "no-collision", "warning", "Link with visual but no collision geometry",
       why="""A link you can see but that has no <collision> passes through everything in simulation
       (no contacts, no self-collision checks), and PyBullet's default inertia comes from the
-      collision shape, so it falls back to a tiny default box.""",
+      collision shape, so it falls back to a tiny default box. Visuals meant to be passed through are
+      not reported: a zero-size placeholder (<box size="0 0 0"/>), and markers, judged against the
+      robot itself: a link drawn much smaller than its other links, or one that weighs next to
+      nothing against the whole robot.""",
       fix="Add a <collision> (a primitive or a simplified mesh).",
       bad=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual></link>'),
       good=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual>'
-                 '<collision><geometry><box size="1 1 1"/></geometry></collision></link>'))
+                 '<collision><geometry><box size="1 1 1"/></geometry></collision></link>'),
+      thresholds=f"Not reported: every visual of zero volume; visuals whose box diagonal is below MARKER_SIZE = "
+                 f"{MARKER_SIZE:g} of the robot's median link size; a link whose mass is at most MARKER_MASS = "
+                 f"{MARKER_MASS:g} of the robot's.")
 def no_collision(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        if link.visuals and not link.collisions:
+        if link.visuals and not link.collisions and not _pass_through_visual(ctx, link):
             yield Hit(f"link '{link.name}' has {len(link.visuals)} visual shape(s) but no <collision>", link.element)
+
+
+def _pass_through_visual(ctx, link) -> bool:
+    """True for a link whose visuals are a placeholder or a marker (see G008), not a part."""
+    boxes = [ctx.shape_bounds(shape) for shape in link.visuals]
+    if boxes and all(box is not None and math.prod(hi - lo for lo, hi in zip(*box)) == 0 for box in boxes):
+        return True  # <box size="0 0 0"/>: drawn as nothing
+    mass = link.inertial.mass if link.inertial is not None else None
+    if mass is not None and math.isfinite(mass) and 0 <= mass <= MARKER_MASS * ctx.total_mass():
+        return True
+    size, scale = ctx.link_size(link), ctx.robot_scale()
+    return size is not None and scale is not None and size < MARKER_SIZE * scale
 
 
 @rule("G009", "pybullet-only-path", "info", "Mesh found only by PyBullet's fallback search",

@@ -35,11 +35,6 @@ def _moving_links(model) -> dict[str, object]:
     return {joint.child: joint for joint in model.joints if joint.moves and joint.child}
 
 
-def _fixed_links(model) -> dict[str, object]:
-    """Link name -> the fixed joint it hangs from (welded to its parent: it never moves by itself)."""
-    return {joint.child: joint for joint in model.joints if joint.type == "fixed" and joint.child}
-
-
 def effectively_zero(moments) -> bool:
     """True when every principal moment is below :data:`EFFECTIVELY_ZERO` in magnitude."""
     return all(abs(m) < EFFECTIVELY_ZERO for m in moments)
@@ -49,6 +44,11 @@ def near_singular(moments) -> bool:
     """True for a positive tensor whose smallest moment is below mjMINVAL or 1e-9 of the largest."""
     smallest, largest = moments[0], moments[-1]
     return 0 < smallest < max(MJ_MINVAL, NEAR_SINGULAR_RATIO * largest) and not effectively_zero(moments)
+
+
+def _valid_body(inertial, moments) -> bool:
+    """A tensor some body could have: positive definite, A + B >= C, not near-singular (else I004, I005, I009)."""
+    return moments[0] > 0 and _triangle_ok(inertial, moments) and not near_singular(moments)
 
 
 def _triangle_ok(inertial, moments) -> bool:
@@ -187,26 +187,60 @@ def inertia_triangle(ctx) -> Iterator[Hit]:
                   inertial.element.find("inertia"))
 
 
-def _zero_tensor_hits(ctx, on_fixed_links: bool) -> Iterator[Hit]:
-    """I006 and I008: positive mass with a missing, zero or effectively zero tensor."""
-    fixed = _fixed_links(ctx.model)
+def _zero_tensor_hits(ctx, in_inert_body: bool) -> Iterator[Hit]:
+    """I006 (``in_inert_body``) and I008: positive mass with a zero or effectively zero tensor, split by
+    whether the rigid body the link is welded into (fixed joints) has rotational inertia of its own.
+    A missing <inertia> is I006's on a moving link (S019 reports it on the others)."""
+    moving = _moving_links(ctx.model)
     for link in ctx.model.links:
         inertial = link.inertial
         if inertial is None or not (inertial.mass or 0) > 0:
             continue
         element = inertial.element.find("inertia")
         if element is None:
-            if not on_fixed_links:  # urdfdom refuses an <inertial> without <inertia>, fixed or not
+            if in_inert_body and link.name in moving:  # urdfdom refuses it too: on other links that is S019's
                 yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg but no <inertia>", inertial.element)
             continue
-        if (link.name in fixed) != on_fixed_links or not finite_tensor(inertial.tensor):
+        if not finite_tensor(inertial.tensor):
             continue
-        where = f" on fixed joint '{fixed[link.name].name}'" if on_fixed_links else ""
-        if not any(inertial.tensor):
-            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and an all-zero inertia tensor", element)
-        elif effectively_zero(moments := tensor_moments(inertial.tensor)):
-            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and an effectively zero inertia "
-                      f"tensor: principal moments {_fmt(moments)}, all below {EFFECTIVELY_ZERO:g} kg·m²", element)
+        if any(inertial.tensor):
+            moments = tensor_moments(inertial.tensor)
+            if not effectively_zero(moments):
+                continue
+            what = (f"an effectively zero inertia tensor: principal moments {_fmt(moments)}, all below "
+                    f"{EFFECTIVELY_ZERO:g} kg·m²")
+        else:
+            what = "an all-zero inertia tensor"
+        body = ctx.rigid_body(link)
+        inert = _inert(body)
+        if inert is None or inert != in_inert_body:
+            continue  # a body whose numbers are not finite: F007's
+        welded = [name for name in body.members if name != link.name]
+        if in_inert_body:
+            shown = ", ".join(f"'{name}'" for name in welded[:3]) + (", ..." if len(welded) > 3 else "")
+            also = f", nor have the links welded to it ({shown})" if welded else ""
+            yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg and {what}{also}", element)
+        else:
+            joint = ctx.model.parent_joint(link.name)
+            where = f" on fixed joint '{joint.name}'" if joint is not None and joint.type == "fixed" else ""
+            carrier = max(welded, key=lambda name: _mass(ctx.model.link(name)))
+            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and {what}; welded into one body "
+                      f"with '{carrier}', whose inertia carries it", element)
+
+
+def _mass(link) -> float:
+    """The link's mass when it is a positive finite number, else 0."""
+    mass = link.inertial.mass if link is not None and link.inertial is not None else None
+    return mass if mass is not None and math.isfinite(mass) and mass > 0 else 0.0
+
+
+def _inert(body) -> bool | None:
+    """True when a rigid body has no usable rotational inertia (its composite's smallest moment is below
+    mjMINVAL, or below 1e-9 of its largest), None when its numbers are not finite."""
+    if not all(map(math.isfinite, body.moments)):
+        return None
+    smallest, largest = body.moments[0], body.moments[-1]
+    return not smallest >= max(MJ_MINVAL, NEAR_SINGULAR_RATIO * largest)
 
 
 _ZERO_TENSOR = '<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>'
@@ -222,25 +256,31 @@ _ZERO_TENSOR = '<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy=
       (or on the root, which floats unless fixed by the loader) PyBullet divides by the zero moments
       and the joint accelerations blow up; MuJoCo's URDF import reads an all-zero tensor as
       "not given" and refuses a moving body whose moments are below mjMINVAL. urdfdom refuses an
-      <inertial> without <inertia> outright. Links welded to their parent by a fixed joint are
-      I008's.""",
+      <inertial> without <inertia> outright. Engines simulate links welded by fixed joints as one
+      body (MuJoCo fuses them, PyBullet's articulated solver carries their inertia together), so a
+      zero tensor is reported here only when that whole body has no rotational inertia; a virtual
+      root (mass 1e-10, zero tensor) welded to a body with real inertia is I008's, an info (measured:
+      stable fixed and floating in PyBullet 3.2.7 and MuJoCo 4.0).""",
       fix="Compute the tensor from the geometry (box: m(y²+z²)/12 ...; ar3cli fix-inertia).",
       bad=arm(link_extra=_ZERO_TENSOR),
       good=arm(), fixed_by="fix-inertia",
-      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m² (MuJoCo's mjMINVAL).",
+      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m² (MuJoCo's mjMINVAL); "
+                 "the welded body lacks inertia when its composite tensor's smallest moment is below MJ_MINVAL or "
+                 "NEAR_SINGULAR_RATIO = 1e-9 of its largest.",
       references="MuJoCo user_model.cc (moving bodies need mass and moments >= mjMINVAL) and xml_urdf.cc (an "
                  "all-zero tensor is undefined); urdfdom link.cpp "
                  "parseInertial (\"Inertial element must have inertia element\").")
 def inertia_zero(ctx) -> Iterator[Hit]:
-    yield from _zero_tensor_hits(ctx, on_fixed_links=False)
+    yield from _zero_tensor_hits(ctx, in_inert_body=True)
 
 
-@rule("I008", "inertia-zero-fixed-link", "info", "Zero inertia tensor with positive mass on a link on a fixed joint",
-      why="""A link welded to its parent by a fixed joint never rotates by itself: every engine
-      adds its mass to the parent's body (PyBullet and Drake weld it, MuJoCo can fuse it), where a point
-      mass at an offset is harmless. Still, the zero tensor is not the part's real inertia (sensor
-      frames and tool flanges often carry a placeholder mass), and the link becomes a problem the day
-      the joint is made movable.""",
+@rule("I008", "inertia-zero-fixed-link", "info", "Zero inertia tensor on a link welded to a body that has inertia",
+      why="""A link welded by fixed joints to links with real inertia never rotates by itself: every
+      engine simulates the welded links as one body (PyBullet and Drake weld it, MuJoCo fuses it), whose
+      composite inertia carries the point mass. That covers a sensor frame or flange on a fixed joint,
+      and a virtual root (mass 0 or 1e-10) welded to the real base: measured stable fixed and floating
+      in PyBullet 3.2.7 and MuJoCo 4.0. Still, the zero tensor is not the part's real inertia, and the
+      link becomes a problem the day the joint is made movable. A body with no inertia at all is I006's.""",
       fix="Compute the tensor from the geometry (ar3cli fix-inertia), or drop the mass if the link is a pure frame.",
       bad=robot(f"""
           <link name="base">{LINK_INERTIAL}</link><link name="flange">{_ZERO_TENSOR}</link>
@@ -249,9 +289,11 @@ def inertia_zero(ctx) -> Iterator[Hit]:
           <link name="base">{LINK_INERTIAL}</link><link name="flange">{LINK_INERTIAL}</link>
           <joint name="flange_joint" type="fixed"><parent link="base"/><child link="flange"/></joint>"""),
       fixed_by="fix-inertia",
-      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m².")
+      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m². The welded body "
+                 "has inertia when its composite tensor (parallel-axis terms included) has every moment at least "
+                 "MJ_MINVAL and at least NEAR_SINGULAR_RATIO = 1e-9 of its largest.")
 def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
-    yield from _zero_tensor_hits(ctx, on_fixed_links=True)
+    yield from _zero_tensor_hits(ctx, in_inert_body=False)
 
 
 @rule("I009", "inertia-near-singular", "error", "Near-singular inertia tensor on a moving link",
@@ -263,9 +305,9 @@ def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
       body ("mass and inertia of moving bodies must be larger than mjMINVAL"; (2.2e-18, 0.215,
       0.215) is refused). A moment below 1e-9 of the largest belongs to no real body (a rod's ratio
       is 6(r/L)²): it is a typo or lost digits, and it makes the body's inertia ill-conditioned (condition
-      number above 1e9) where a solver inverts it: a floating base, a ball joint. Links on fixed
-      joints are exempt (their inertia is added to the parent's); tensors that also break A + B >= C
-      are I005's.""",
+      number above 1e9) where a solver inverts it: a floating base, a ball joint. Links welded by fixed
+      joints to links whose inertia carries them are exempt (engines simulate the welded links as one
+      body); tensors that also break A + B >= C are I005's.""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="2.2e-18" ixy="0" ixz="0" iyy="0.215" iyz="0" izz="0.215"/></inertial>'),
       good=arm(link_extra='<inertial><mass value="1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.215" iyz="0" izz="0.215"/></inertial>'),
@@ -274,14 +316,12 @@ def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
                  "times the largest, while the largest is at least 1e-15 (else I006/I008).",
       references="MuJoCo include/mujoco/mjtnum.h (mjMINVAL) and src/user/user_model.cc (moving-body check).")
 def inertia_near_singular(ctx) -> Iterator[Hit]:
-    fixed = _fixed_links(ctx.model)
-
     def ok(inertial, moments) -> bool:
         return not near_singular(moments) or not _triangle_ok(inertial, moments)
 
     for link, inertial, moments in _tensor_hits(ctx, ok):
-        if link.name in fixed or not (inertial.mass or 0) > 0:
-            continue
+        if not (inertial.mass or 0) > 0 or _inert(ctx.rigid_body(link)) is not True:
+            continue  # welded to links whose inertia carries it (or numbers that are not finite: F007's)
         smallest, largest = moments[0], moments[-1]
         why = (f"below MuJoCo's mjMINVAL {MJ_MINVAL:g}: MuJoCo refuses the body" if smallest < MJ_MINVAL else
                f"{smallest / largest:.1e} of the largest: no real body is that thin")
@@ -293,7 +333,8 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
       why="""The radius of gyration sqrt(I_max / m) of a body is at most the size of the body (about
       its COM it cannot exceed the diagonal of its bounding box). A much larger value means the
       tensor belongs to something else: a placeholder I = 1 on a 0.1 kg link, grams vs kilograms, or
-      g·mm² vs kg·m². The link then swings like a body many metres wide.""",
+      g·mm² vs kg·m². The link then swings like a body many metres wide. A tensor no body can have
+      (I004, I005, I009) is reported there alone.""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="0.1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
                          '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'),
@@ -312,8 +353,8 @@ def inertia_implausible(ctx) -> Iterator[Hit]:
             continue
         half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
         moments = tensor_moments(inertial.tensor)
-        if half_diagonal <= 0 or moments[-1] <= 0:
-            continue
+        if half_diagonal <= 0 or moments[-1] <= 0 or not _valid_body(inertial, moments):
+            continue  # a tensor no body has is I004's, I005's or I009's: one cause, one finding
         gyration = math.sqrt(moments[-1] / inertial.mass)
         if gyration > IMPLAUSIBLE_FACTOR * half_diagonal:
             yield Hit(f"link '{link.name}' radius of gyration {gyration:.3g} m is {gyration / half_diagonal:.0f}x "

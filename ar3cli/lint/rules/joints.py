@@ -96,10 +96,21 @@ def _pybullet_unlimited_idiom(joint) -> bool:
       bad=arm(joint_extra='<limit lower="0" upper="0" effort="10" velocity="1"/>'), good=arm())
 def limit_empty(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
-        limit = joint.limit
-        if joint.type in LIMITED_TYPES and limit and limit.lower is not None and limit.lower == limit.upper \
-                and limit.element.get("lower") is not None and limit.element.get("upper") is not None:
-            yield Hit(f"joint '{joint.name}' has lower == upper == {limit.lower:g}: it cannot move", limit.element)
+        if _cannot_move(joint):
+            limit = joint.limit
+            zeros = [f"{key}={value:g}" for key, value in (("effort", limit.effort), ("velocity", limit.velocity))
+                     if value is not None and value <= 0]
+            also = f" (and {' and '.join(zeros)})" if zeros and joint.mimic is None else ""
+            yield Hit(f"joint '{joint.name}' has lower == upper == {limit.lower:g}{also}: it cannot move",
+                      limit.element)
+
+
+def _cannot_move(joint) -> bool:
+    """A revolute or prismatic joint whose lower and upper limits are written and equal (J004)."""
+    limit = joint.limit
+    return joint.type in LIMITED_TYPES and limit is not None and limit.lower is not None \
+        and limit.lower == limit.upper and limit.element.get("lower") is not None \
+        and limit.element.get("upper") is not None
 
 
 def _looks_like_degrees(value: float) -> bool:
@@ -234,13 +245,15 @@ def effort_velocity_missing(ctx) -> Iterator[Hit]:
 @rule("J008", "effort-velocity-zero", "warning", "Effort or velocity <= 0 on a moving joint",
       why="""effort and velocity are the actuator's limits. Zero means the joint can exert no force or
       cannot move: ros_control and MoveIt respect that, and controllers that take PyBullet's
-      maxForce from the URDF cannot hold the arm against gravity.""",
+      maxForce from the URDF cannot hold the arm against gravity. A <mimic> follower has no actuator
+      of its own (its leader drives it), so its zeros are not reported; nor are those of a joint whose
+      range is a single point (J004 says it cannot move, and lists them).""",
       fix="Use the real actuator limits from the datasheet.",
       bad=arm(joint_extra='<limit lower="-1" upper="1" effort="0" velocity="0"/>'), good=arm())
 def effort_velocity_zero(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
-        if joint.limit is None or joint.type not in ACTUATED_TYPES:
-            continue
+        if joint.limit is None or joint.type not in ACTUATED_TYPES or joint.mimic is not None or _cannot_move(joint):
+            continue  # a mimic follower has no actuator; a joint that cannot move is J004's
         bad = [f"{key}={value:g}" for key, value in (("effort", joint.limit.effort), ("velocity", joint.limit.velocity))
                if value is not None and value <= 0]
         if bad:

@@ -8,12 +8,12 @@ messages name a link or joint ("Element name 'arm'"): the finding points at its 
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
+from ar3cli.lint.rules.pybullet_sim import unstable_hit
 
 SETTLE_SECONDS = 1.0
 MAX_SETTLE_SPEED = 100.0
@@ -41,7 +41,8 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
       why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
       PyBullet's loader: a moving body whose mass or inertia is below mjMINVAL (a link without <inertial>
       and without collision geometry), an inertia breaking A + B >= C, a zero joint axis. ar3cli quotes
-      MuJoCo's reason at the link or joint it names.""",
+      MuJoCo's reason at the link or joint it names; when a static error that MuJoCo refuses (I005,
+      I006, J009, ...) already names the cause at its line, M001 adds nothing.""",
       fix="Fix the reason quoted in the message (often an I or J finding of the same element).",
       bad=arm(link_extra=""), good=arm(), needs_sim=True,
       references="MuJoCo 4.0 user_objects.cc: 'mass and inertia of moving bodies must be larger than mjMINVAL'")
@@ -49,7 +50,7 @@ def mujoco_compile_failed(ctx) -> Iterator[Hit]:
     from ar3cli.sim.mujoco_session import MujocoCompileError
 
     robot, error = _compiled(ctx)
-    if error is not None:
+    if error is not None and refusal_explained(ctx, "mujoco") is None:  # else a static error says why
         if isinstance(error, MujocoCompileError):
             yield Hit(f"MuJoCo cannot compile it: {error.reason}",
                       error.element if error.element is not None else ctx.model.root)
@@ -134,7 +135,9 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
               joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><dynamics damping="-50"/>'
               ).replace('<axis xyz="0 0 1"/>', '<axis xyz="0 1 0"/>'),
       good=arm(), needs_sim=True,
-      thresholds="NaN, mjWARN_BADQACC, or a joint faster than MAX_SETTLE_SPEED = 100 rad/s or m/s after SETTLE_SECONDS = 1 s.")
+      thresholds="NaN, mjWARN_BADQACC, or a joint faster than MAX_SETTLE_SPEED = 100 rad/s or m/s after SETTLE_SECONDS = 1 s; "
+                 "one finding per file, at the first such joint, naming the others (one instability drags every "
+                 "joint below it along).")
 def mujoco_unstable(ctx) -> Iterator[Hit]:
     from ar3cli.sim.mujoco_session import home_pose
 
@@ -143,18 +146,24 @@ def mujoco_unstable(ctx) -> Iterator[Hit]:
         return
     robot.set_positions(home_pose(ctx.model))
     robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
-    bad_acceleration = int(robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)].number)
-    reported = False
+    warning = robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)]
+    bad_acceleration = int(warning.number)
+    blamed = _blamed_joint(robot, int(warning.lastinfo)) if bad_acceleration else None
+    states = []
     for name, (position, velocity) in zip(robot.joint_ids, robot.joint_states(list(robot.joint_ids))):
         joint = ctx.model.joint(name)
-        element = joint.element if joint is not None else None
-        if not (math.isfinite(position) and math.isfinite(velocity)):
-            reported = True
-            yield Hit(f"joint '{name}' state is NaN/inf after {SETTLE_SECONDS:g} s under gravity in MuJoCo", element)
-        elif abs(velocity) > MAX_SETTLE_SPEED:
-            reported = True
-            yield Hit(f"joint '{name}' moves at {velocity:.3g} after {SETTLE_SECONDS:g} s under gravity in MuJoCo",
-                      element)
-    if bad_acceleration and not reported:
+        states.append((name, joint.element if joint is not None else None, position, velocity))
+    found = unstable_hit(states, f"after {SETTLE_SECONDS:g} s under gravity in MuJoCo", MAX_SETTLE_SPEED, blamed)
+    if found is not None:
+        yield found
+    elif bad_acceleration:
         yield Hit(f"MuJoCo reported {bad_acceleration} unstable step(s) (bad acceleration; the simulation was reset)",
                   ctx.model.root)
+
+
+def _blamed_joint(robot, dof: int) -> str | None:
+    """The joint of the degree of freedom MuJoCo's bad-acceleration warning names (its ``lastinfo``)."""
+    try:
+        return robot.m.joint(int(robot.m.dof_jntid[dof])).name or None
+    except (IndexError, KeyError, ValueError):
+        return None

@@ -55,6 +55,28 @@ def rigid_masses(model) -> dict[str, float]:
     return {link.name: totals[find(link.name)] for link in model.links}
 
 
+def subtree_masses(model) -> dict[str, float]:
+    """Link name -> the mass of the link and everything below it (what its parent joint moves): the
+    joint-space inertia a joint sees is that of its whole subtree, so a light link between two joints
+    of a finger is carried by the finger below it. Masses as in :func:`rigid_masses`. Linear: links in
+    breadth-first order from the roots, then each one's total added to its parent's, deepest first (a
+    link reached twice, or in a loop no root reaches, counts its own mass only: S006's business)."""
+    totals = {link.name: (mass if (mass := link.inertial.mass if link.inertial is not None else None) is not None
+                          and math.isfinite(mass) and mass > 0 else 0.0) for link in model.links}
+    order = [link.name for link in model.root_links()]
+    seen = set(order)
+    for name in order:  # grows while it is walked: breadth-first
+        for joint in model.child_joints(name):
+            if joint.child in totals and joint.child not in seen:
+                seen.add(joint.child)
+                order.append(joint.child)
+    for name in reversed(order):
+        joint = model.parent_joint(name)
+        if joint is not None and joint.parent in seen and joint.parent != name:
+            totals[joint.parent] += totals[name]
+    return totals
+
+
 def _primitive_volume(shape) -> float | None:
     """Exact volume of a box, cylinder, sphere or capsule (m³), None for meshes and unknown shapes."""
     kind, params = shape.geometry.kind, shape.geometry.params
@@ -138,21 +160,23 @@ def _mass_element(link):
       why="""A moving link of less than a gram next to kilogram links makes the joint-space inertia
       matrix ill-conditioned: PyBullet and MuJoCo then need tiny time steps, and the joint
       accelerations of that link jitter or blow up. Real moving parts weigh grams at least; a link
-      this light is usually a frame that should hang from a fixed joint, or a mass in the wrong unit.""",
+      this light is usually a frame that should hang from a fixed joint, or a mass in the wrong unit.
+      What a joint moves is its whole subtree: a light link between two joints (the cross of a
+      universal joint in a finger) is carried by the links below it and is not reported.""",
       fix="Give the link its real mass, or attach a frame-only link with a fixed joint.",
       bad=arm(link_extra='<inertial><mass value="0.00001"/><inertia ixx="1e-9" ixy="0" ixz="0" iyy="1e-9" iyz="0" izz="1e-9"/></inertial>'),
       good=arm(),
-      thresholds=f"Moving links (revolute, continuous, prismatic, planar, floating, spherical) whose rigid group (the link "
-                 f"and the links fixed joints weld to it) weighs more than 0 and less than {MIN_MASS:g} kg.",
+      thresholds=f"Moving links (revolute, continuous, prismatic, planar, floating, spherical) whose subtree (the link "
+                 f"and every link below it) weighs more than 0 and less than {MIN_MASS:g} kg.",
       references="MuJoCo documentation, Computation (ill-conditioned mass matrices need smaller timesteps).")
 def mass_tiny(ctx) -> Iterator[Hit]:
     moving = {joint.child: joint for joint in ctx.model.joints if joint.moves and joint.child}
-    group = rigid_masses(ctx.model)
+    carried = subtree_masses(ctx.model)
     for link in ctx.model.links:
         mass = link.inertial.mass if link.inertial is not None else None
-        if link.name in moving and mass is not None and mass > 0 and 0 < group[link.name] < MIN_MASS:
-            yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') and weighs {group[link.name]:g} kg "
-                      "with the links welded to it", link.inertial.element.find("mass"))
+        if link.name in moving and mass is not None and mass > 0 and 0 < carried[link.name] < MIN_MASS:
+            yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') and weighs {carried[link.name]:g} kg "
+                      "with everything below it", link.inertial.element.find("mass"))
 
 
 @rule("I015", "mass-ratio", "warning", "Masses across a joint differ more than solvers handle",

@@ -178,8 +178,9 @@ def _unknown_children(ctx) -> Iterator[tuple]:
                 continue
             if tag in attrs:
                 continue  # S018: an attribute written as an element
-            guess = _closest(tag, children)
-            if guess is None and (element_tag == "robot" or not _home_of(tag)):
+            # a URDF element's own name is no misspelling: it is in the wrong place (<inertial> under <robot>)
+            guess = None if tag in SCHEMA else _closest(tag, children)
+            if guess is None and (element_tag == "robot" and tag not in SCHEMA or not _home_of(tag)):
                 continue  # an extension (<gazebo>, <sensor>, <joint_properties>, ...), not a misspelling
             yield element, child, guess
 
@@ -223,7 +224,8 @@ def unknown_element(ctx) -> Iterator[Hit]:
       bad=arm().replace('<axis xyz="0 0 1"/>', '<axis xzy="0 0 1"/>'),
       good=arm(),
       thresholds="Reported: a misspelling of an allowed attribute the element does not also have (difflib similarity "
-                 ">= 0.6, lengths within 2); iyx, izx, izy are ixy, ixz, iyz (the tensor is symmetric). Other unknown "
+                 ">= 0.6, lengths within 2); iyx, izx, izy are ixy, ixz, iyz (the tensor is symmetric): alone they are "
+                 "reported, next to their twin only when the two values differ. Other unknown "
                  "attributes are taken for extensions (ANYmal's command_effort, Isaac's dont_collapse).",
       references="wiki.ros.org/urdf/XML (link, joint); urdfdom xsd/urdf.xsd; urdfdom urdf_parser/src/pose.cpp, "
                  "joint.cpp, link.cpp.")
@@ -240,8 +242,23 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
             guess = _closest(name, attrs)
             if guess is None or (guess in element.attrib and name not in INERTIA_SYMMETRY):
                 continue  # an extension's attribute (command_effort, dont_collapse, twist), not a misspelling
+            if guess in element.attrib:  # iyx next to ixy: the tensor's redundant twin
+                if _same_number(element.get(name), element.get(guess)):
+                    continue  # written twice, read once: nothing is lost
+                yield Hit(f"{_owner(element)} has {name}=\"{element.get(name)}\" and {guess}=\"{element.get(guess)}\": the "
+                          f"tensor is symmetric, parsers read {guess} and ignore {name}", element,
+                          hint=f"Keep the value you mean in {guess}= and delete {name}=.")
+                continue
             yield Hit(f"{_owner(element)} has an unknown attribute {name}=\"{element.get(name)}\" (did you mean "
                       f"{guess}?): {WHAT_PARSERS_DO}", element, hint=f"Rename {name}= to {guess}=.")
+
+
+def _same_number(a: str | None, b: str | None) -> bool:
+    """Whether two attribute texts hold the same number ("0" and "0.0"), or the same text."""
+    try:
+        return float(a or "") == float(b or "")
+    except ValueError:
+        return (a or "").strip() == (b or "").strip()
 
 
 @rule("S018", "attribute-as-element", "error", "Attribute written as a child element",
@@ -301,9 +318,10 @@ def missing_required_child(ctx) -> Iterator[Hit]:
         if element_tag == "inertial" and link is not None and link.get("name") in moving:
             continue  # I003 (mass) and I006 (inertia) report moving links
         present = {child_tag for _child, child_tag in element_children}
-        for tag in required:
-            if tag not in present:  # element.find(tag) is None
-                yield Hit(f"{_owner(element)} has no <{tag}>: urdfdom refuses the link, and the file", element)
+        missing = [tag for tag in required if tag not in present]  # element.find(tag) is None
+        if missing:  # one finding per element, whatever it lacks
+            yield Hit(f"{_owner(element)} has no {' and no '.join(f'<{tag}>' for tag in missing)}: urdfdom refuses "
+                      "the link, and the file", element)
 
 
 VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "deceleration": "limit", "jerk": "limit"}

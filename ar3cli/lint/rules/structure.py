@@ -15,12 +15,13 @@ PYBULLET_JOINT_TYPES = ("spherical",)
 
 @rule("S001", "robot-name", "error", "<robot> has no name",
       engines=("ros",), refused_by=("ros",), breaks="urdfdom (check_urdf, robot_state_publisher) refuses the file.",
-      why="urdfdom (check_urdf, ROS robot_state_publisher) refuses a <robot> without a name attribute.",
+      why="""urdfdom (check_urdf, ROS robot_state_publisher) refuses a <robot> without a name attribute. An
+      empty <robot> (no links either) is S011's, which says the name is missing too.""",
       fix='Add name="..." to <robot>.',
       bad='<?xml version="1.0"?>\n<robot>\n  <link name="base"/>\n</robot>\n',
       good=robot('<link name="base"/>'))
 def robot_name(ctx) -> Iterator[Hit]:
-    if not (ctx.model.root.get("name") or "").strip():
+    if not (ctx.model.root.get("name") or "").strip() and ctx.model.links:  # an empty <robot> is S011's
         yield Hit("<robot> has no name attribute", ctx.model.root)
 
 
@@ -249,7 +250,8 @@ def pybullet_joint_type(ctx) -> Iterator[Hit]:
       good=robot('<link name="base"/>'))
 def no_links(ctx) -> Iterator[Hit]:
     if not ctx.model.links:
-        yield Hit("<robot> has no <link> elements", ctx.model.root)
+        unnamed = "" if (ctx.model.root.get("name") or "").strip() else " (and no name)"
+        yield Hit(f"<robot> has no <link> elements{unnamed}: nothing to load", ctx.model.root)
 
 
 def _transmissions(model):
