@@ -162,17 +162,33 @@ def lfs_pointer(ctx) -> Iterator[Hit]:
       why="""URDF meshes are in metres. A mesh exported in millimetres loads silently 1000x too large
       in PyBullet (a 30 cm link becomes 300 m); one scaled twice becomes sub-millimetre. Flat meshes
       (ground planes, walls) are exempt. A COLLADA file states its own unit (<unit meter="0.0254"/>
-      for inches), which PyBullet and assimp (RViz, MoveIt) apply: the size is judged after it.""",
+      for inches), which PyBullet and assimp (RViz, MoveIt) apply: the size is judged after it. Judged
+      against the link itself too: a collision mesh about 1000 times larger or smaller than its own
+      visual (a scale="0.001" kept on one and not the other) is in the other unit, whatever its size;
+      the one further from the robot's typical link size is the one reported.""",
       fix='Add scale="0.001 0.001 0.001" for a millimetre mesh, or re-export it in metres.',
       bad=_mesh_robot("meshes/base_mm.stl"), good=_mesh_robot("meshes/base_mm.stl", "0.001 0.001 0.001"),
       thresholds="Largest extent after scale (and COLLADA unit) above MAX_PLAUSIBLE_EXTENT = 5 m with the smallest "
-                 "above FLAT_RATIO = 0.01 of it, or below MIN_PLAUSIBLE_EXTENT = 1 mm.",
+                 "above FLAT_RATIO = 0.01 of it, or below MIN_PLAUSIBLE_EXTENT = 1 mm; or a link's collision meshes "
+                 "SCALE_MISMATCH = 250 to 4000 times larger or smaller than its visual meshes (box diagonals).",
       references="PyBullet LoadMeshFromCollada.cpp (applies <unit meter>); COLLADA 1.4.1 spec, <asset>/<unit>.")
 def mesh_units(ctx) -> Iterator[Hit]:
     from ar3cli.urdf.meshinfo import collada_unit
 
+    judged: set[int] = set()  # meshes whose unit their own link's other meshes already showed
+    for link in ctx.model.links:
+        for shape, factor, ratio, other in scale_mismatches(ctx, link):
+            judged.add(id(shape.geometry.element))
+            scale = " ".join(number_text(v * factor) for v in shape.geometry.params.get("scale") or (1.0, 1.0, 1.0))
+            looks = "like millimetres" if factor < 1 else "scaled to metres twice"
+            yield Hit(f"link '{link.name}' {shape.role} mesh {shape.geometry.filename} is {ratio:.0f}x "
+                      f"{'larger' if factor < 1 else 'smaller'} than the link's {other} mesh: it looks {looks}, its "
+                      f"{other} is in metres (scale=\"{scale}\"?)", shape.geometry.element,
+                      hint=f'Write scale="{scale}" on this mesh, as its {other} says.')
     seen: set[tuple] = set()
     for link, _shape, geometry in _meshes(ctx):
+        if id(geometry.element) in judged:
+            continue
         bounds = ctx.scaled_mesh_bounds(geometry)
         if bounds is None:
             continue
@@ -196,6 +212,92 @@ def mesh_units(ctx) -> Iterator[Hit]:
         elif 0 < largest < MIN_PLAUSIBLE_EXTENT:
             yield Hit(f"link '{link.name}' mesh {geometry.filename} is only {shown}: scaled twice?",
                       geometry.element, hint="Check the scale attribute: the mesh may already be in metres.")
+
+
+SCALE_MISMATCH = (250.0, 4000.0)
+"""A link's collision meshes this many times larger or smaller than its visual meshes (box diagonals): one
+of the two is in millimetres and the other in metres (G006)."""
+
+
+def scale_mismatches(ctx, link) -> list[tuple[object, float, float, str]]:
+    """(mesh shape at fault, the factor its scale needs, how many times off it is, the role it disagrees with)
+    for each of the link's meshes that is about 1000x (:data:`SCALE_MISMATCH`) larger or smaller than its
+    counterpart of the other role: the visual mesh of the same file for a collision mesh, else the link's
+    visual meshes together. Of the two, the one whose size is further from the median of the robot's other
+    links is at fault; with no other link to compare with, the one outside the sizes a part can have
+    (MIN_PLAUSIBLE_EXTENT to MAX_PLAUSIBLE_EXTENT), else the collision (people look at the visual, not at
+    the collision). Empty when the link's visual and collision meshes agree."""
+    visuals = [shape for shape in link.visuals if shape.geometry.kind == "mesh"]
+    collisions = [shape for shape in link.collisions if shape.geometry.kind == "mesh"]
+    if not visuals or not collisions:
+        return []
+    scale = _median_of_others(ctx, link)
+    found: dict[int, tuple[object, float, float, str]] = {}
+    for collision in collisions:
+        twin = [v for v in visuals if _same_file(v.geometry, collision.geometry)]
+        counterpart = twin or visuals
+        sizes = [_size([ctx.shape_bounds(collision)]), _size([ctx.shape_bounds(shape) for shape in counterpart])]
+        if None in sizes:
+            continue
+        ratio = max(sizes) / min(sizes)
+        if not SCALE_MISMATCH[0] <= ratio <= SCALE_MISMATCH[1]:
+            continue
+        big_is_collision = sizes[0] > sizes[1]
+        big, small = max(sizes), min(sizes)
+        if scale is not None:
+            blame_big = abs(math.log(big / scale)) >= abs(math.log(small / scale))
+        else:
+            plausible = [MIN_PLAUSIBLE_EXTENT <= size <= MAX_PLAUSIBLE_EXTENT for size in (big, small)]
+            blame_big = big_is_collision if plausible[0] == plausible[1] else not plausible[0]
+        factor = 1e-3 if blame_big else 1e3
+        if blame_big == big_is_collision:
+            found.setdefault(id(collision), (collision, factor, ratio, "visual"))
+        else:
+            for shape in counterpart:
+                found.setdefault(id(shape), (shape, factor, ratio, "collision"))
+    return list(found.values())
+
+
+def _median_of_others(ctx, link) -> float | None:
+    """The median size (:meth:`Context.link_size`) of the robot's links other than ``link``: the sizes
+    sorted once per file, this link's taken out by index (a 20,000-link robot asks for every link)."""
+    import bisect
+
+    sizes = ctx.shared("link-sizes", lambda model: sorted(
+        size for other in model.links if (size := ctx.link_size(other)) and math.isfinite(size)))
+    own = ctx.link_size(link)
+    index = bisect.bisect_left(sizes, own) if own and math.isfinite(own) else None
+    count = len(sizes) - (index is not None)
+    if count <= 0:
+        return None
+    middle = count // 2
+    return sizes[middle + 1] if index is not None and middle >= index else sizes[middle]
+
+
+def _same_file(a, b) -> bool:
+    """Two mesh geometries that name the same file (resolved, else as written)."""
+    if a.resolution is not None and b.resolution is not None and a.resolution.found and b.resolution.found:
+        return a.resolution.path == b.resolution.path
+    return (a.filename or "").strip() == (b.filename or "").strip()
+
+
+def _size(boxes) -> float | None:
+    """The diagonal of the box around ``boxes``; None when one is unknown or the size is not positive."""
+    if not boxes or any(box is None for box in boxes):
+        return None
+    size = math.dist(*union_box(boxes))
+    return size if size > 0 and math.isfinite(size) else None
+
+
+def union_box(boxes):
+    """The box around ``boxes`` (none of them None)."""
+    return (tuple(min(box[0][i] for box in boxes) for i in range(3)),
+            tuple(max(box[1][i] for box in boxes) for i in range(3)))
+
+
+def number_text(value: float) -> str:
+    """A scale factor as URDF text: 0.001, not 0.0010000000000000002."""
+    return f"{value:.6g}"
 
 
 @rule("G007", "scalar-scale", "warning", "Mesh scale is a single number",

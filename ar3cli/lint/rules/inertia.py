@@ -7,6 +7,7 @@ from collections.abc import Iterator
 from functools import lru_cache
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.plausibility import density_implausible, grams_evidence
 from ar3cli.maths.tensor_math import is_positive_definite, satisfies_triangle_inequality, symmetric_eigenvalues
 
 IMPLAUSIBLE_FACTOR = 3.0
@@ -334,32 +335,109 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
       its COM it cannot exceed the diagonal of its bounding box). A much larger value means the
       tensor belongs to something else: a placeholder I = 1 on a 0.1 kg link, grams vs kilograms, or
       g·mm² vs kg·m². The link then swings like a body many metres wide. A tensor no body can have
-      (I004, I005, I009) is reported there alone.""",
+      (I004, I005, I009) is reported there alone. When the tensor read in kg·mm² or g·mm² (a CAD
+      export's units) gives the robot's typical radius of gyration, the message says so, with the
+      value in kg·m².""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="0.1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
                          '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'),
       good=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision>'),
       fixed_by="fix-inertia --include-implausible",
       thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the link's "
-                 "geometry box (collision shapes, else visual).")
+                 "geometry box (collision shapes, else visual). A unit is named when the tensor / 1e6 (kg·mm²) or / 1e9 "
+                 "(g·mm²) gives a ratio within SAME_SHAPE = 5x of the robot's median link ratio and an I_max within "
+                 "SOLID_RANGE = 0.05 to 4 times a solid box the size of the geometry; never for a placeholder (a "
+                 "diagonal of powers of ten).")
 def inertia_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        inertial = link.inertial
-        if inertial is None or not finite_tensor(inertial.tensor) or not (inertial.mass or 0) > 0 \
-                or not math.isfinite(inertial.mass):
+        found = _gyration_ratio(ctx, link)
+        if found is None or found[0] <= IMPLAUSIBLE_FACTOR:
             continue
-        bounds = ctx.link_bounds(link)
-        if bounds is None:
-            continue
-        half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
-        moments = tensor_moments(inertial.tensor)
-        if half_diagonal <= 0 or moments[-1] <= 0 or not _valid_body(inertial, moments):
-            continue  # a tensor no body has is I004's, I005's or I009's: one cause, one finding
-        gyration = math.sqrt(moments[-1] / inertial.mass)
-        if gyration > IMPLAUSIBLE_FACTOR * half_diagonal:
-            yield Hit(f"link '{link.name}' radius of gyration {gyration:.3g} m is {gyration / half_diagonal:.0f}x "
-                      f"its geometry's half-diagonal {half_diagonal:.3g} m (mass {inertial.mass:g} kg, "
-                      f"I_max {moments[-1]:.3g} kg·m²)", inertial.element.find("inertia"))
+        ratio, gyration, half_diagonal, largest = found
+        unit = tensor_unit(ctx, link)
+        looks = (f": the tensor looks like {unit[0]} (I_max {largest / unit[1]:.3g} kg·m²?)" if unit is not None else "")
+        yield Hit(f"link '{link.name}' radius of gyration {gyration:.3g} m is {ratio:.0f}x "
+                  f"its geometry's half-diagonal {half_diagonal:.3g} m (mass {link.inertial.mass:g} kg, "
+                  f"I_max {largest:.3g} kg·m²){looks}", link.inertial.element.find("inertia"),
+                  hint=(f"Divide every inertia entry by {unit[1]:.0e} (kg·m²), or recompute it: ar3cli fix-inertia "
+                        "rescales it." if unit is not None else None))
+
+
+def _gyration_ratio(ctx, link, mass: float | None = None) -> tuple[float, float, float, float] | None:
+    """(radius of gyration / the half-diagonal of the link's geometry box, the radius of gyration
+    sqrt(I_max / m), the half-diagonal, I_max) of a valid tensor, with the file's mass (or ``mass``);
+    None when there is nothing to compare."""
+    inertial = link.inertial
+    mass = mass if mass is not None else (inertial.mass if inertial is not None else None)
+    if inertial is None or not finite_tensor(inertial.tensor) or mass is None or not mass > 0 \
+            or not math.isfinite(mass):
+        return None
+    bounds = ctx.link_bounds(link)
+    if bounds is None:
+        return None
+    half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
+    moments = tensor_moments(inertial.tensor)
+    if half_diagonal <= 0 or moments[-1] <= 0 or not _valid_body(inertial, moments):
+        return None  # a tensor no body has is I004's, I005's or I009's: one cause, one finding
+    gyration = math.sqrt(moments[-1] / mass)
+    return gyration / half_diagonal, gyration, half_diagonal, moments[-1]
+
+
+TENSOR_UNITS = (("kg·mm²", 1e6), ("g·mm²", 1e9))
+"""Units a CAD export writes tensors in, and how many of them make a kg·m² (I007)."""
+SAME_SHAPE = 5.0
+"""A tensor taken in another unit must give a radius of gyration within this factor of the robot's
+typical link (relative to each link's own size) to be said to be in that unit."""
+
+
+SOLID_RANGE = (0.05, 4.0)
+"""... and an I_max within this range of a solid box's the size of the link's geometry (a part fills part of
+its box; a thin shell about its COM reaches a few times the solid box)."""
+
+
+def _placeholder_tensor(tensor) -> bool:
+    """A diagonal tensor of powers of ten (I = 1; pr2's sensor frames' 1e-4, 1e-6, 1e-4): a placeholder
+    someone typed, not a CAD export in another unit."""
+    ixx, ixy, ixz, iyy, iyz, izz = tensor
+    if ixy or ixz or iyz or not min(ixx, iyy, izz) > 0:
+        return False
+    return all(abs(math.log10(value) - round(math.log10(value))) < 1e-9 for value in (ixx, iyy, izz))
+
+
+def typical_gyration(ctx) -> float:
+    """The median, over the robot's links with a plausible tensor, of radius of gyration / half-diagonal
+    (how its parts fill their boxes); 0.5 (a solid part) when no link has one."""
+    def build(_model) -> float:
+        ratios = sorted(found[0] for link in ctx.model.links
+                        if (found := _gyration_ratio(ctx, link)) is not None and found[0] <= IMPLAUSIBLE_FACTOR)
+        return ratios[len(ratios) // 2] if ratios else 0.5
+    return ctx.shared("typical-gyration", build)
+
+
+def tensor_unit(ctx, link) -> tuple[str, float] | None:
+    """(unit, kg·m² divisor) when the link's tensor looks written in kg·mm² or g·mm² (x1e6, x1e9): taken in
+    that unit, its radius of gyration, with the link's mass in kg (read as grams when I013 says so), is
+    plausible and within SAME_SHAPE of the robot's typical link, and its I_max within SOLID_RANGE of a solid
+    box the size of the link's geometry; the closest such unit. A placeholder (I = 1) is no unit. None
+    otherwise."""
+    mass = grams_evidence(ctx, link)
+    found = _gyration_ratio(ctx, link, mass)
+    if found is None or found[0] <= IMPLAUSIBLE_FACTOR or _placeholder_tensor(link.inertial.tensor):
+        return None
+    mass = mass or link.inertial.mass
+    box = ctx.link_bounds(link)
+    extents = sorted(hi - lo for lo, hi in zip(*box))
+    solid = mass * (extents[1] ** 2 + extents[2] ** 2) / 12  # I_max of a solid box the size of the geometry
+    typical = typical_gyration(ctx)
+    best = None
+    for unit, divisor in TENSOR_UNITS:
+        converted = found[0] / math.sqrt(divisor)
+        if converted <= IMPLAUSIBLE_FACTOR and typical / SAME_SHAPE <= converted <= typical * SAME_SHAPE \
+                and SOLID_RANGE[0] * solid <= found[3] / divisor <= SOLID_RANGE[1] * solid:
+            miss = abs(math.log(converted / typical))
+            if best is None or miss < best[0]:
+                best = (miss, unit, divisor)
+    return None if best is None else (best[1], best[2])
 
 
 @rule("I010", "mass-zero-with-inertia", "info", "Mass 0 with a non-zero inertia tensor",
@@ -450,5 +528,33 @@ FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_
          inertia_triangle, inertia_zero, inertia_zero_fixed_link, inertia_near_singular, inertia_implausible)
 """The rules whose links fix-inertia recomputes (:func:`ar3cli.fix.inertia_plan.links_needing_inertia`),
 in its order of reasons: I007 last, so a link reported as I007 has nothing invalid."""
+RESCALED_BY_FIX_INERTIA = (density_implausible,)
+"""Rules fix-inertia answers by rescaling the file's own numbers where their unit is plain (a mass in grams,
+I013; I007's tensors in kg·mm² or g·mm² too): :func:`unit_mistakes`."""
 NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
 """Inertia findings fix-inertia leaves alone: the fix is a decision only the author can make."""
+
+
+def unit_mistakes(ctx) -> dict[str, tuple[float, float, str]]:
+    """Link name -> (mass divisor, tensor divisor, why) for the links whose mass (I013) or tensor (I007) the
+    rules say is in another unit: a mass in grams (/ 1000; its tensor with it when, read with the gram
+    mass, the tensor is a plausible body's) and a tensor in kg·mm² or g·mm². fix-inertia rescales them."""
+    found: dict[str, tuple[float, float, str]] = {}
+    for link in ctx.model.links:
+        grams = grams_evidence(ctx, link)
+        unit = tensor_unit(ctx, link)
+        if grams is None and unit is None:
+            continue
+        reasons, mass_divisor, tensor_divisor = [], 1.0, 1.0
+        if grams is not None:
+            mass_divisor = link.inertial.mass / grams
+            reasons.append(f"I013: mass {link.inertial.mass:g} in grams, / 1000")
+            plain = _gyration_ratio(ctx, link)
+            if unit is None and plain is not None and plain[0] <= IMPLAUSIBLE_FACTOR:
+                tensor_divisor = mass_divisor  # the tensor was written for the gram mass: in g·m²
+                reasons.append("tensor in g·m² with it, / 1000")
+        if unit is not None:
+            tensor_divisor = unit[1]
+            reasons.append(f"I007: tensor in {unit[0]}, / {unit[1]:.0e}")
+        found[link.name] = (mass_divisor, tensor_divisor, "; ".join(reasons))
+    return found

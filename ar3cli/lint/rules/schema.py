@@ -150,7 +150,7 @@ def _schema_elements(ctx) -> tuple:
     return ctx.shared("schema-elements", lambda model: tuple(node[0] for node in _schema_nodes(ctx)))
 
 
-def _owner(element) -> str:
+def owner(element) -> str:
     """"link 'arm' <visual> <origin>" for messages."""
     path, node = [], element
     while node is not None and node.tag not in ("link", "joint", "material", "robot"):
@@ -210,7 +210,7 @@ def unknown_element(ctx) -> Iterator[Hit]:
         else:
             advice = f"<{child.tag}> belongs in <{'> or <'.join(homes)}>"
             hint = f"Move <{child.tag}> into <{homes[0]}>."
-        yield Hit(f"{_owner(parent)} has an unknown child <{child.tag}> ({advice}): {WHAT_PARSERS_DO}", child,
+        yield Hit(f"{owner(parent)} has an unknown child <{child.tag}> ({advice}): {WHAT_PARSERS_DO}", child,
                   hint=hint)
 
 
@@ -245,11 +245,11 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
             if guess in element.attrib:  # iyx next to ixy: the tensor's redundant twin
                 if _same_number(element.get(name), element.get(guess)):
                     continue  # written twice, read once: nothing is lost
-                yield Hit(f"{_owner(element)} has {name}=\"{element.get(name)}\" and {guess}=\"{element.get(guess)}\": the "
+                yield Hit(f"{owner(element)} has {name}=\"{element.get(name)}\" and {guess}=\"{element.get(guess)}\": the "
                           f"tensor is symmetric, parsers read {guess} and ignore {name}", element,
                           hint=f"Keep the value you mean in {guess}= and delete {name}=.")
                 continue
-            yield Hit(f"{_owner(element)} has an unknown attribute {name}=\"{element.get(name)}\" (did you mean "
+            yield Hit(f"{owner(element)} has an unknown attribute {name}=\"{element.get(name)}\" (did you mean "
                       f"{guess}?): {WHAT_PARSERS_DO}", element, hint=f"Rename {name}= to {guess}=.")
 
 
@@ -284,7 +284,7 @@ def attribute_as_element(ctx) -> Iterator[Hit]:
             if tag not in attrs or tag in SCHEMA[element_tag][1]:
                 continue
             value = " ".join((child.text or "").split()) or "..."
-            yield Hit(f"{_owner(element)} has <{tag}> as a child element: parsers read only the attribute "
+            yield Hit(f"{owner(element)} has <{tag}> as a child element: parsers read only the attribute "
                       f"{tag}=\"...\" and ignore the element", child,
                       hint=f"Write <{element.tag} {tag}=\"{value}\" .../> and delete the <{tag}> element.")
 
@@ -320,7 +320,7 @@ def missing_required_child(ctx) -> Iterator[Hit]:
         present = {child_tag for _child, child_tag in element_children}
         missing = [tag for tag in required if tag not in present]  # element.find(tag) is None
         if missing:  # one finding per element, whatever it lacks
-            yield Hit(f"{_owner(element)} has no {' and no '.join(f'<{tag}>' for tag in missing)}: urdfdom refuses "
+            yield Hit(f"{owner(element)} has no {' and no '.join(f'<{tag}>' for tag in missing)}: urdfdom refuses "
                       "the link, and the file", element)
 
 
@@ -351,6 +351,6 @@ def undeclared_urdf_version(ctx) -> Iterator[Hit]:
         for name in element.keys():  # noqa: SIM118 - an lxml element: iterating it gives its children
             if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
-                yield Hit(f"{_owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
+                yield Hit(f"{owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
                           "(urdfdom ignores it)", element,
                           hint=f'Declare <robot name="..." version="{major}.{minor}"> (or later).')
