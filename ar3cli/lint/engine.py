@@ -25,6 +25,7 @@ from ar3cli.findings import Finding, Severity
 from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
+from ar3cli.lint.rules.file import LIBRARY
 
 if TYPE_CHECKING:
     from ar3cli.lint.result_cache import ResultCache
@@ -249,6 +250,8 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
+    if not model.links and not model.joints and is_macro_library(model):  # a xacro library: one info line (F008)
+        rules = [] if matches(LIBRARY, options.ignore) else [REGISTRY[LIBRARY]]
     static, simulated, in_mujoco = _partition(rules)
     findings = _run_rules(model, shown, static, options)
     error = None
@@ -266,6 +269,13 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
                 error = exc.message
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
+
+
+def is_macro_library(model) -> bool:
+    """Whether ``model``'s file is a xacro library that makes no robot (:mod:`ar3cli.urdf.macro_library`)."""
+    from ar3cli.urdf.macro_library import macro_library
+
+    return macro_library(model, find_includers=False) is not None
 
 
 def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:

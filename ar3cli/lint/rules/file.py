@@ -182,3 +182,38 @@ def malformed_number(ctx) -> Iterator[Hit]:
             found.sort(key=lambda item: order.index(item[0]))  # reported in the spec's order, as ever
         for key, text, problem in found:
             yield Hit(f"<{element.tag} {key}=\"{text}\"> {problem}", element)
+
+
+LIBRARY = "F008"
+"""The code of a xacro library's one line (:func:`macro_library_file`): the engine runs it alone on such a file."""
+
+
+@rule(LIBRARY, "macro-library", "info", "A xacro library: macros, no robot",
+      why="""A robot's urdf/ folder holds one entry file and files that only define xacro macros (or
+      properties, or materials) for it to include: leg.xacro, utils/*.xacro, materials.xacro. Such a
+      file instantiates no robot, so it has no name, no links and no joints of its own, and every
+      robot rule would call it broken. Its content is checked where an entry file includes it: the
+      entry file's findings point at this file's lines. This one line says so, and names the files of
+      its package that include it.""",
+      fix="Nothing to fix here: lint the entry file that includes it (lint-urdf on the folder does).",
+      bad='''<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:property name="length" value="0.3"/>
+  <xacro:macro name="segment" params="name">
+    <link name="${name}"/>
+  </xacro:macro>
+</robot>
+''',
+      good=robot('<link name="base"/>'),
+      thresholds="A file that makes no link and no joint, whose top level holds only xacro macro, property, arg and "
+                 "include elements (also inside if/unless) and <material>s, and at least one macro, property or material. "
+                 "The files that include it are looked for in its package (at most 400 files).")
+def macro_library_file(ctx) -> Iterator[Hit]:
+    from ar3cli.urdf.macro_library import macro_library
+
+    library = macro_library(ctx.model)
+    if library is not None:
+        where = (f"included by {', '.join(library.included_by)}" if library.included_by
+                 else "no file of its package was found to include it")
+        yield Hit(f"{library.describe()} and instantiates no robot: a xacro library, checked where an entry file "
+                  f"includes it ({where})", ctx.model.root)
