@@ -82,23 +82,30 @@ def rpy_degrees(ctx) -> Iterator[Hit]:
                       hint=f'Write rpy="{converted}".')
 
 
-def _rotating_speeds(model) -> list[tuple[object, float]]:
-    """(joint, velocity) of the revolute and continuous joints with a positive velocity, mimics left out."""
-    return [(joint, joint.limit.velocity) for joint in model.joints
-            if joint.type in ROTATING_JOINT_TYPES and joint.limit is not None and joint.mimic is None
-            and joint.limit.velocity is not None and math.isfinite(joint.limit.velocity) and joint.limit.velocity > 0]
+def _rotating_speeds(model) -> list[tuple[float, object]]:
+    """(velocity, joint) of the revolute and continuous joints with a positive velocity, mimics left out,
+    sorted by velocity."""
+    return sorted(((joint.limit.velocity, joint) for joint in model.joints
+                   if joint.type in ROTATING_JOINT_TYPES and joint.limit is not None and joint.mimic is None
+                   and joint.limit.velocity is not None and math.isfinite(joint.limit.velocity)
+                   and joint.limit.velocity > 0), key=lambda item: item[0])
 
 
-def degree_speed(model, joint) -> tuple[float, object] | None:
+def degree_speed(speeds, joint) -> tuple[float, object] | None:
     """(the velocity in rad/s, the joint whose speed it matches) when ``joint``'s velocity looks like deg/s:
     a round number of degrees per second which, converted, is within SAME_SPEED of another rotating joint
-    of the robot that moves at least DEGREE_SPEED_RATIO times slower as written. None otherwise."""
-    speeds = _rotating_speeds(model)
-    mine = next((speed for other, speed in speeds if other is joint), None)
-    if mine is None or mine <= FULL_TURN or mine > 720 or mine % DEGREE_SPEED_STEP:
+    of the robot that moves at least DEGREE_SPEED_RATIO times slower as written; None otherwise.
+    ``speeds`` is :func:`_rotating_speeds` of the robot (found by bisection: linear in the joints)."""
+    import bisect
+
+    mine = joint.limit.velocity if joint.limit is not None else None
+    if mine is None or not FULL_TURN < mine <= 720 or mine % DEGREE_SPEED_STEP or joint.mimic is not None:
         return None
     converted = math.radians(mine)
-    for other, speed in speeds:
+    start = bisect.bisect_left(speeds, converted / (1 + SAME_SPEED), key=lambda item: item[0])
+    for speed, other in speeds[start:]:
+        if speed > converted / (1 - SAME_SPEED):
+            break
         if other is not joint and mine >= DEGREE_SPEED_RATIO * speed and abs(converted - speed) <= SAME_SPEED * speed:
             return converted, other
     return None
@@ -128,8 +135,9 @@ def degree_speed(model, joint) -> tuple[float, object] | None:
                  f"rotating joint's velocity w, with v >= DEGREE_SPEED_RATIO = {DEGREE_SPEED_RATIO:g} x w.",
       fixed_by="fix-joints")
 def velocity_degrees(ctx) -> Iterator[Hit]:
+    speeds = _rotating_speeds(ctx.model)
     for joint in ctx.model.joints:
-        found = degree_speed(ctx.model, joint)
+        found = degree_speed(speeds, joint) if joint.type in ROTATING_JOINT_TYPES else None
         if found is not None:
             converted, other = found
             velocity = joint.limit.element.get("velocity")
@@ -213,8 +221,15 @@ def com_outside(ctx, link) -> tuple[float, float, str] | None:
         return None
     near = max(size, 1e-9)  # "inside" is within one box size: a COM need not sit in the box of a thin part
     millimetres = tuple(v / 1000 for v in com)
-    if _outside(millimetres, box) <= near:
+    typical = _typical_com_offset(ctx)
+    if _outside(millimetres, box) <= near and (typical is None or math.hypot(*millimetres) / size >= typical / 10):
         return distance, size, f"it looks like millimetres (xyz=\"{' '.join(f'{v:.6g}' for v in millimetres)}\" m?)"
+    angle = next(((axis, value, fraction) for axis, value in zip("xyz", com)
+                  if (fraction := _angle_fraction(value)) is not None and abs(value) > size), None)
+    if angle is not None:
+        axis, value, fraction = angle
+        return distance, size, (f"its {axis} {value:g} is {fraction}: an angle in radians, an rpy value typed into "
+                                "xyz?")
     joint = ctx.model.parent_joint(link.name)
     if joint is not None and all(map(math.isfinite, joint.origin.xyz)):
         rotation, shift = joint.origin.rotation, joint.origin.xyz
@@ -223,6 +238,44 @@ def com_outside(ctx, link) -> tuple[float, float, str] | None:
             return distance, size, (f"it looks like it is written in the frame of the parent link '{joint.parent}' "
                                     f"(xyz=\"{' '.join(f'{v:.6g}' for v in moved)}\" in this link's frame?)")
     return distance, size, "it belongs to another body, or another frame"
+
+
+def _typical_com_offset(ctx) -> float | None:
+    """The median, over the robot's links whose COM lies inside their geometry's box and off its origin, of
+    the COM's distance from the link origin over the link's size: how far from their frames this robot's
+    parts carry their mass. A COM in millimetres, read in metres, lands about as far (I016); one that
+    lands on the origin (1.047 "mm" on a 16 cm part) is no millimetre slip."""
+    def build(_model) -> float | None:
+        ratios = []
+        for link in ctx.model.links:
+            inertial = link.inertial
+            box = _union([ctx.shape_bounds(shape) for shape in (*link.visuals, *link.collisions)])
+            if inertial is None or box is None or not all(map(math.isfinite, inertial.origin.xyz)):
+                continue
+            size, offset = math.dist(*box), math.hypot(*inertial.origin.xyz)
+            if size > 0 and offset > 0 and _outside(inertial.origin.xyz, box) == 0:
+                ratios.append(offset / size)
+        ratios.sort()
+        return ratios[len(ratios) // 2] if ratios else None
+    return ctx.shared("typical-com-offset", build)
+
+
+ANGLE_STEPS = 12
+"""An xyz value equal to k·π/12 (15° steps: π/6, π/4, π/3, π/2, π ...) to 1e-5 is an angle in radians."""
+
+
+def _angle_fraction(value: float) -> str | None:
+    """"-π/3" when ``value`` is a multiple of π/12 (to 1e-5 relative), else None."""
+    steps = value / (math.pi / ANGLE_STEPS)
+    k = round(steps)
+    if k == 0 or abs(steps - k) > 1e-5 * abs(steps) or abs(k) > 2 * ANGLE_STEPS:
+        return None
+    from fractions import Fraction
+
+    ratio = Fraction(abs(k), ANGLE_STEPS)
+    sign = "-" if k < 0 else ""
+    numerator = "" if ratio.numerator == 1 else str(ratio.numerator)
+    return f"{sign}{numerator}π" + (f"/{ratio.denominator}" if ratio.denominator != 1 else "")
 
 
 @rule("I016", "com-outside-body", "warning", "Centre of mass far outside the link's geometry",
@@ -235,8 +288,10 @@ def com_outside(ctx, link) -> tuple[float, float, str] | None:
       bad=_com_robot("0 0 150"), good=_com_robot("0 0 0.15"),
       thresholds=f"COM further from the box around the link's visual and collision shapes than COM_FACTOR = "
                  f"{COM_FACTOR:g} box diagonals and than COM_SCALE = {COM_SCALE:g} of the robot's median link size. "
-                 "It looks like millimetres (or the parent's frame) when xyz / 1000 (or xyz moved into the link's "
-                 "frame by its joint origin) lies within one box diagonal of the box.")
+                 "It looks like millimetres when xyz / 1000 lies within one box diagonal of the box, as far from the "
+                 "link origin (relative to the link's size) as a tenth of the robot's typical link at least; like an "
+                 "angle when a component beyond the box is a multiple of π/12; like the parent's frame when xyz moved "
+                 "into the link's frame by its joint origin lies within one box diagonal of the box.")
 def com_outside_body(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
         found = com_outside(ctx, link)
