@@ -115,14 +115,19 @@ class Context:
         return self._shared["total-mass"]
 
     def rigid_body(self, link: Link) -> RigidBody:
-        """The :class:`RigidBody` ``link`` belongs to (computed once per file for every link)."""
-        if "rigid-bodies" not in self._shared:
-            self._shared["rigid-bodies"] = self._rigid_bodies()
-        return self._shared["rigid-bodies"][link.name]
+        """The :class:`RigidBody` ``link`` belongs to: the groups are found once per file, a group's
+        composite inertia the first time one of its links is asked about (few files need any)."""
+        if "rigid-groups" not in self._shared:
+            self._shared["rigid-groups"] = self._rigid_groups()
+        placed, groups, bodies = self._shared["rigid-groups"]
+        top = placed[link.name][0]
+        if top not in bodies:
+            bodies[top] = RigidBody(top, tuple(groups[top]), *self._composite(groups[top], placed))
+        return bodies[top]
 
-    def _rigid_bodies(self) -> dict[str, RigidBody]:
-        """Every link's rigid body: each link's pose in the frame of the top of its chain of fixed
-        joints (a loop in a broken file ends the walk), then each group's composite inertia."""
+    def _rigid_groups(self) -> tuple[dict, dict[str, list[str]], dict[str, RigidBody]]:
+        """(each link's (top, rotation, origin) in the frame of the top of its chain of fixed joints (a
+        loop in a broken file ends the walk), top -> its members, an empty cache of bodies)."""
         model = self.model
         placed: dict[str, tuple[str, Matrix, tuple[float, float, float]]] = {}
         for link in model.links:
@@ -141,11 +146,7 @@ class Context:
         groups: dict[str, list[str]] = {}
         for link in model.links:
             groups.setdefault(placed[link.name][0], []).append(link.name)
-        bodies: dict[str, RigidBody] = {}
-        for top, members in groups.items():
-            body = RigidBody(top, tuple(members), *self._composite(members, placed))
-            bodies.update((name, body) for name in members)
-        return bodies
+        return placed, groups, {}
 
     def _composite(self, members, placed) -> tuple[float, tuple[float, float, float]]:
         """(mass, principal moments about the common COM) of ``members`` placed in their top's frame."""

@@ -366,7 +366,15 @@ def inertia_implausible(ctx) -> Iterator[Hit]:
 def _gyration_ratio(ctx, link, mass: float | None = None) -> tuple[float, float, float, float] | None:
     """(radius of gyration / the half-diagonal of the link's geometry box, the radius of gyration
     sqrt(I_max / m), the half-diagonal, I_max) of a valid tensor, with the file's mass (or ``mass``);
-    None when there is nothing to compare."""
+    None when there is nothing to compare. Once per link, mass and file."""
+    known = ctx.shared("gyration-ratios", lambda _model: {})
+    key = (id(link), mass)
+    if key not in known:
+        known[key] = _gyration(ctx, link, mass)
+    return known[key]
+
+
+def _gyration(ctx, link, mass: float | None) -> tuple[float, float, float, float] | None:
     inertial = link.inertial
     mass = mass if mass is not None else (inertial.mass if inertial is not None else None)
     if inertial is None or not finite_tensor(inertial.tensor) or mass is None or not mass > 0 \

@@ -103,7 +103,15 @@ def _box_volume(ctx, shape) -> float | None:
 
 def density_bounds(ctx, link) -> tuple[float | None, float | None]:
     """(highest possible density, lowest possible density) in kg/m³ from the link's collision shapes;
-    each None when the shapes cannot bound it."""
+    each None when the shapes cannot bound it. Once per link and file (I013, its grams evidence and the
+    robot's typical density all ask)."""
+    known = ctx.shared("density-bounds", lambda _model: {})
+    if id(link) not in known:  # the model, and with it every link, lives as long as the context
+        known[id(link)] = _density_bounds(ctx, link)
+    return known[id(link)]
+
+
+def _density_bounds(ctx, link) -> tuple[float | None, float | None]:
     mass = link.inertial.mass if link.inertial is not None else None
     if mass is None or not mass >= DENSITY_MIN_MASS or not math.isfinite(mass) or not link.collisions:
         return None, None

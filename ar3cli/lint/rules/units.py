@@ -152,6 +152,7 @@ def _soft_robot(soft: str) -> str:
 
 
 @rule("J017", "soft-limits-outside", "warning", "<safety_controller> soft limits outside the hard limits",
+      engines=("ros",),
       why="""The safety controller (pr2_controller_manager, ros_control's joint_limits_interface) starts
       pushing back at the soft limits so that the joint never reaches its hard stop. Soft limits
       outside [lower, upper] never act before the stop: the protection the file describes does not
