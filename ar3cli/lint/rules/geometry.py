@@ -317,7 +317,7 @@ def scalar_scale(ctx) -> Iterator[Hit]:
 MARKER_SIZE = 0.1
 """A link whose visuals are smaller (box diagonal) than this fraction of the robot's median link is a
 marker (a sensor frame drawn as a 1 cm cube, pr2's and Talos' IMU boxes), not a part to collide with."""
-MARKER_MASS = 1e-3
+MARKER_MASS = 1e-4
 """A link lighter than this fraction of the whole robot (or of mass 0) is a frame with a picture (Baxter's
 0.1 g display and camera links, a "nocol" marker sphere), not a body."""
 
