@@ -193,9 +193,7 @@ def refusal_explained(ctx, engine: str) -> str | None:
     """The code of a static rule that fires on this file and says ``engine`` refuses it (its
     ``refused_by``), or None: P001 and M001, which load the file, then add nothing to the static
     finding that already names the cause at its line (one cause, one finding)."""
-    from ar3cli.lint.rules import RULES  # the registry, complete by the time a rule runs
-
-    for rule in RULES:
+    for rule in registered():  # every rule: the package imported all its modules before any rule runs
         if engine in rule.refused_by and not rule.needs_sim and rule.check is not None:
             for _hit in rule.check(ctx):
                 return rule.code
