@@ -110,11 +110,13 @@ def test_unexpanded_substitution_names_the_prefix_not_the_namespace_uri():
 
 
 @pytest.mark.slow
-def test_one_instability_is_one_finding():
+def test_one_instability_is_one_finding(tmp_path, monkeypatch):
     pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
+    monkeypatch.chdir(tmp_path)
     findings = _lint("unstable_chain.urdf", select=("M004",), sim=True, engines=("mujoco",))
     (finding,) = findings
     assert finding.line == _line("unstable_chain.urdf", 'name="shoulder"') and "more joint" in finding.message
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()  # MuJoCo's warning did not become a file in the cwd
 
 
 def test_a_load_failure_a_static_error_explains_is_not_restated():

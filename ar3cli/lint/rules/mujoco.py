@@ -8,6 +8,7 @@ messages name a link or joint ("Element name 'arm'"): the finding points at its 
 
 from __future__ import annotations
 
+import contextlib
 from collections.abc import Iterator
 from typing import Any
 
@@ -145,7 +146,8 @@ def mujoco_unstable(ctx) -> Iterator[Hit]:
     if robot is None or not robot.joint_ids:
         return
     robot.set_positions(home_pose(ctx.model))
-    robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
+    with _warnings_kept(robot):
+        robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
     warning = robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)]
     bad_acceleration = int(warning.number)
     blamed = _blamed_joint(robot, int(warning.lastinfo)) if bad_acceleration else None
@@ -159,6 +161,18 @@ def mujoco_unstable(ctx) -> Iterator[Hit]:
     elif bad_acceleration:
         yield Hit(f"MuJoCo reported {bad_acceleration} unstable step(s) (bad acceleration; the simulation was reset)",
                   ctx.model.root)
+
+
+@contextlib.contextmanager
+def _warnings_kept(robot):
+    """MuJoCo's warnings while the robot is simulated go to ``robot.warnings``: its default handler prints
+    them and appends them to MUJOCO_LOG.TXT in the current directory, a file nobody asked for."""
+    previous = robot.mujoco.get_mju_user_warning()
+    robot.mujoco.set_mju_user_warning(lambda text: robot.warnings.append(str(text).strip()))
+    try:
+        yield
+    finally:
+        robot.mujoco.set_mju_user_warning(previous)
 
 
 def _blamed_joint(robot, dof: int) -> str | None:
