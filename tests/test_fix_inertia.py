@@ -299,12 +299,16 @@ def test_options_and_io_errors(cli, tmp_path, write_urdf):
 
 
 def test_real_ar3_link_3_com_one_metre_away_is_fixed_on_request(cli, tmp_path, shared_dir):
-    """The real ar3.urdf puts link_3's COM at z = -1.047 m, on a 10 cm part. The lint rules (so far)
-    do not flag a misplaced COM, so it is fixed with --links: mass kept, COM and tensor recomputed."""
+    """The real ar3.urdf puts link_3's COM at z = -1.047 m (-π/3: an angle typed into xyz), on a 10 cm part.
+    I016 says so; fix-inertia does not guess the COM meant, so it is fixed with --links: mass kept, COM and
+    tensor recomputed, and I016 is quiet afterwards."""
     real = shared_dir / "models" / "ar3_description"
     original = (real / "urdf" / "ar3.urdf").read_text()
     path = write(tmp_path / "ar3.urdf", original)
     package = f"ar3_description={real}"
+    com_rule = json.loads(cli("lint-urdf", "--no-cache", "--select", "I016", "--format", "json", "--package-path", package,
+                              str(path)).stdout)["findings"]
+    assert [f["message"].split("'")[1] for f in com_rule] == ["link_3"] and "-π/3" in com_rule[0]["message"]
     check = cli("fix-inertia", str(path), "--links", "link_3", "--check", "--package-path", package,
                 "--format", "json")
     assert check.code == 1
@@ -316,6 +320,8 @@ def test_real_ar3_link_3_com_one_metre_away_is_fixed_on_request(cli, tmp_path, s
     mass, com, _ = inertial_of(path, "link_3")
     assert mass == 0.1787 and np.linalg.norm(com) < 0.1
     assert cli("fix-inertia", str(path), "--links", "link_3", "--check", "--package-path", package).code == 0
+    assert json.loads(cli("lint-urdf", "--no-cache", "--select", "I016", "--format", "json", "--package-path", package,
+                          str(path)).stdout)["findings"] == []
 
 
 @pytest.mark.parametrize("geometry", ['<cylinder radius="0.1" length="0"/>', '<cylinder radius="nan" length="0.2"/>',

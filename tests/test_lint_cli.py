@@ -8,6 +8,7 @@ from pathlib import Path
 
 import pytest
 
+from ar3cli.lint.rules import REGISTRY
 from ar3cli.lint.rules.base import arm
 from tests.conftest import ASSETS
 
@@ -257,8 +258,12 @@ def test_sim_rules_run_only_with_sim(cli, write_urdf):
     assert not any(f["rule"].startswith("P") for f in static["findings"])
     simulated = cli("lint-urdf", path, "--sim", "--format", "json")
     doc = json.loads(simulated.stdout)  # stdout is JSON alone even though pybullet printed
-    (p001,) = [f for f in doc["findings"] if f["rule"] == "P001"]
-    assert "does not specify limits" in p001["message"]
+    rules = [f["rule"] for f in doc["findings"]]
+    assert "J001" in rules and "P001" not in rules  # PyBullet refuses it, and J001 already says why, at its line
+    unexplained = str(write_urdf(REGISTRY["P001"].bad))  # a <cylinder> without length: no static rule sees it
+    (p001,) = [f for f in json.loads(cli("lint-urdf", unexplained, "--sim", "--format", "json").stdout)["findings"]
+               if f["rule"] == "P001"]
+    assert "has no length attribute" in p001["message"], p001
 
 
 def test_select_never_hides_a_file_that_cannot_be_loaded(cli, tmp_path):

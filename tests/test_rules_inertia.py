@@ -26,8 +26,11 @@ def test_zero_tensor_on_a_fixed_link_is_info_and_on_a_moving_link_an_error(tmp_p
 
 
 def test_missing_inertia_element_is_an_error_even_on_a_fixed_link(tmp_path):
+    """urdfdom refuses it: S019 says so on a link that does not move (I006 on one that does), once."""
     path = write_fixture(tmp_path, fixed_child('<inertial><mass value="1"/></inertial>'))
-    assert codes_for(path, "I006") and codes_for(path, "I008") == []
+    (finding,) = codes_for(path, "S019")
+    assert finding.severity is Severity.ERROR and "no <inertia>" in finding.message
+    assert codes_for(path, "I006") == [] and codes_for(path, "I008") == []
 
 
 def test_effectively_zero_tensor_is_called_so_not_a_triangle_or_definiteness_problem(tmp_path):
@@ -102,7 +105,7 @@ def test_fix_inertia_fixes_exactly_the_rules_that_say_so():
         assert rule.fixed_by is None, rule.code
     assert inertia.FIXED_BY_FIX_INERTIA[-1].code == "I007"  # fix-inertia reads I007 as "nothing invalid": it must come last
     assert {r.code for r in RULES if r.fixed_by and r.fixed_by.startswith("fix-inertia")} == \
-        {r.code for r in inertia.FIXED_BY_FIX_INERTIA}
+        {r.code for r in (*inertia.FIXED_BY_FIX_INERTIA, *inertia.RESCALED_BY_FIX_INERTIA)}
 
 
 def test_metadata_reaches_the_docs_and_the_rule_object():

@@ -33,7 +33,7 @@ def _line_of(path: Path, needle: str) -> int:
     ("S016", "<axes", "did you mean <axis>"),
     ("S017", 'xzy="0 1 0"', "did you mean xyz"),
     ("S017", 'ryp="0 0 1"', "did you mean rpy"),
-    ("S017", 'iyx="0.5"', "did you mean ixy"),
+    ("S017", 'iyx="0.5"', "parsers read ixy and ignore iyx"),
     ("S018", "<damping>5", "damping"),
     ("S019", '<visual><origin ryp', "no <geometry>"),
     ("G014", '<origin xyz="0 0 3.0"/>', "joint 'j2'"),
@@ -48,7 +48,7 @@ def test_each_injected_class_is_found_at_its_element(code, needle, words):
 
 def test_misspelt_names_get_a_rename_hint():
     hints = {f.hint for f in _findings(DATA / "injected.urdf", select=("S016", "S017"))}
-    assert {"Rename <orign> to <origin>.", "Rename xzy= to xyz=.", "Rename iyx= to ixy=."}.issubset(hints)
+    assert {"Rename <orign> to <origin>.", "Rename xzy= to xyz=.", "Keep the value you mean in ixy= and delete iyx=."}.issubset(hints)
 
 
 def test_extensions_and_declared_urdf_12_stay_quiet():
@@ -67,7 +67,7 @@ def test_undeclared_version_feature_is_a_hint(tmp_path):
 
 def test_target_rules_run_only_for_their_engines():
     default = {r.code for r in LintOptions().rules() if r.code.startswith("T")}
-    assert default == {"T001"}
+    assert default == {"T001", "T009"}
     isaac = {r.code for r in LintOptions(targets=("isaac",)).rules() if r.code.startswith("T")}
     assert isaac == {"T005", "T006", "T007"}
     assert "T003" in {r.code for r in LintOptions(select=["ALL", "T003"]).rules()}  # naming the code runs it

@@ -60,6 +60,13 @@ def info(
         return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
 
     model = source.load(path)
+    from ar3cli.urdf.macro_library import macro_library
+
+    library = macro_library(model)
+    if library is not None:  # macros for an entry file to include: nothing to summarise here
+        from ar3cli.info.presentation import library_report
+
+        finish(library_report(path, library), format)
     summary = summarize(model, zero_frames)
     check = None
     if torques:

@@ -1,5 +1,9 @@
 """The fix-inertia fixer: choose links, pick each link's mass source, write new ``<inertial>``s.
 
+Numbers in another unit, by default: a mass the linter says is in grams (I013: too dense, and in
+kilograms the density of the robot's other links) is divided by 1000, a tensor it says is in kg·mm² or
+g·mm² (I007) by 1e6 or 1e9: the file's own values in SI, centre of mass and axes kept.
+
 Which links, by default: those the lint inertia rules flag as **invalid** (no ``<inertial>``,
 mass <= 0, tensor not positive definite, A + B < C, all-zero tensor). A link flagged only as
 **implausible** (I007: a valid tensor too large for the geometry) is often a hand-tuned value or a
@@ -172,7 +176,10 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
 
     plan = FixPlan()
     cache: dict = {}
+    rescaled = set() if options.all_links or options.link_names else _rescale_units(model, document, plan, options)
     selected, left_alone = _select(model, options)
+    selected = {name: reason for name, reason in selected.items() if name not in rescaled}
+    left_alone = [item for item in left_alone if item.link not in rescaled]
     if left_alone:
         plan.notes.append(_left_alone_note(left_alone))
         plan.data["left_alone"] = [asdict(item) for item in left_alone]
@@ -208,6 +215,45 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
     plan.changes.sort(key=lambda change: change.line)
     plan.skipped.sort(key=lambda skipped: skipped.line)
     return plan
+
+
+def _rescale_units(model, document: Document, plan: FixPlan, options: InertiaOptions) -> set[str]:
+    """Divide the mass and tensor of the links whose numbers the linter says are in another unit (a mass in
+    grams, I013; a tensor in kg·mm² or g·mm², I007: :func:`~ar3cli.lint.rules.inertia.unit_mistakes`): the
+    file's own values in kg and kg·m², the one right answer (centre of mass and axes kept). Links given a
+    --mass, or whose findings an inline comment ignores, are left to the other paths. The names done."""
+    from ar3cli.lint.context import Context
+    from ar3cli.lint.engine import suppressed_inline
+    from ar3cli.lint.rules.inertia import unit_mistakes
+
+    context = Context(model)
+    try:
+        mistakes = unit_mistakes(context)
+    finally:
+        context.close()
+    done: set[str] = set()
+    for name, (mass_divisor, tensor_divisor, reason) in mistakes.items():
+        link = model.link(name)
+        inertial = link.inertial.element
+        mass, tensor = inertial.find("mass"), inertial.find("inertia")
+        if name in options.masses or any(suppressed_inline(element, code) for element, code in
+                                         ((mass, "I013"), (tensor, "I007")) if element is not None):
+            continue
+        element = _element(link)
+        if mass_divisor != 1.0:
+            _set(document, plan, mass, "value", number(link.inertial.mass / mass_divisor), element, reason,
+                 same=_same_numbers)
+        if tensor_divisor != 1.0 and tensor is not None:
+            old = {key: tensor.get(key) for key in TENSOR_KEYS}
+            new = {key: number(value / tensor_divisor) for key, value in zip(TENSOR_KEYS, link.inertial.tensor)}
+            span = document.span(tensor)
+            for key, value in new.items():
+                if not _same_numbers(old[key], value):
+                    document.set_attribute(span, key, value)
+            plan.changes.append(Change(element, tensor.sourceline or link.line, "inertia", _tensor_text(old),
+                                       _tensor_text(new), reason))
+        done.add(name)
+    return done
 
 
 def _valid_file_mass(link) -> float | None:
@@ -417,7 +463,8 @@ FIXER = Fixer[InertiaOptions]("fix-inertia", plan_inertia, options=InertiaOption
 Recompute mass, centre of mass and inertia tensor of links from their geometry.
 
 By default it fixes only links whose inertia is invalid (missing, mass <= 0, not positive
-definite, A + B < C, all zero) and lists the valid but implausible ones (I007) it left alone;
+definite, A + B < C, all zero), rescales a mass in grams or a tensor in kg*mm^2 / g*mm^2 where the
+linter shows the unit (I013, I007), and lists the valid but implausible ones (I007) it left alone;
 --include-implausible recomputes those too.
 Edits only the fixed `<inertial>` elements, byte for byte, and writes atomically. A link
 without a valid mass needs --density, --mass or --total-mass: there is no default density.

@@ -15,7 +15,12 @@ to a rule's heuristic changes the fixer with it):
 * J010 (axis not a unit vector): normalised, written with :func:`~ar3cli.fix.driver.number`;
 * J007 (``<limit>`` without effort or velocity): filled from MoveIt's ``joint_limits.yaml``
   (``--limits-from``, its max_effort / max_velocity when has_*_limits is true), else from
-  ``--effort`` / ``--velocity``; when neither says, the joint is reported as not fixed.
+  ``--effort`` / ``--velocity``; when neither says, the joint is reported as not fixed;
+* J015 (a joint origin's rpy beyond a full turn: typed in degrees): the three angles converted to
+  radians (the origins of visuals, collisions and inertials are left to the author: the lint hint
+  gives their value);
+* J016 (a velocity that is a round number of deg/s and, converted, another joint's speed): converted
+  to rad/s.
 
 :func:`verify` loads the written file in PyBullet and reads each changed joint back.
 """
@@ -34,6 +39,7 @@ from ar3cli.urdf.edits import Document
 from ar3cli.urdf.joint_limits_yaml import YamlLimits, read_joint_limits
 
 INVERTED, DEGREES, AXIS_ZERO, EFFORT_VELOCITY_MISSING, AXIS_NOT_UNIT = "J003", "J005", "J009", "J007", "J010"
+RPY_DEGREES, VELOCITY_DEGREES = "J015", "J016"
 """The lint rules whose findings fix-joints acts on."""
 UNLIMITED_IDIOM = "J014"
 """PyBullet's lower > upper "no limit" idiom: reported in a note, never changed."""
@@ -93,7 +99,8 @@ def plan_joints(model, document: Document, options: JointsOptions) -> FixPlan:
         if model.joint(name) is None:
             plan.notes.append(f"warning: {options.limits_path}: joint {name!r} is not in {model.path}")
     flagged = {code: flagged_joints(model, code)
-               for code in (INVERTED, DEGREES, AXIS_ZERO, AXIS_NOT_UNIT, EFFORT_VELOCITY_MISSING)}
+               for code in (INVERTED, DEGREES, AXIS_ZERO, AXIS_NOT_UNIT, EFFORT_VELOCITY_MISSING, RPY_DEGREES,
+                            VELOCITY_DEGREES)}
     swapped: list[str] = []
     for joint in model.joints:
         path = _path(joint.element)
@@ -111,6 +118,10 @@ def plan_joints(model, document: Document, options: JointsOptions) -> FixPlan:
             _normalise_axis(document, plan, joint)
         if path in flagged[EFFORT_VELOCITY_MISSING]:
             _fill_effort_velocity(document, plan, joint, options)
+        if path in flagged[RPY_DEGREES]:
+            _origin_to_radians(document, plan, joint)
+        if path in flagged[VELOCITY_DEGREES]:
+            _velocity_to_radians(document, plan, joint)
     if swapped:
         plan.notes.append(f"note: {model.path}: PyBullet reads lower > upper as 'no limit'; the swapped joint(s) "
                           f"{', '.join(swapped)} are limited to [lower, upper] there now. If the file meant unlimited, "
@@ -158,6 +169,28 @@ def _fix_range(document: Document, plan: FixPlan, joint, *, swap: bool, degrees:
         document.set_attribute(span, key, new)
         plan.changes.append(Change(_element(joint), line, f"limit {key}", old, new, "; ".join(reasons)))
     _record(plan, joint, lower=values["lower"], upper=values["upper"])
+
+
+def _origin_to_radians(document: Document, plan: FixPlan, joint) -> None:
+    """J015: the joint origin's rpy, typed in degrees, in radians (all three angles, as the rule's hint)."""
+    origin = joint.origin.element
+    old = origin.get("rpy")
+    new = " ".join(number(math.radians(value)) for value in map(float, old.split()))
+    document.set_attribute(document.span(origin), "rpy", new)
+    plan.changes.append(Change(_element(joint), origin.sourceline or joint.line, "origin rpy", old, new,
+                               f"{RPY_DEGREES}: degrees, converted to radians (x pi/180)"))
+
+
+def _velocity_to_radians(document: Document, plan: FixPlan, joint) -> None:
+    """J016: a velocity typed in deg/s, in rad/s."""
+    limit = joint.limit
+    old = limit.element.get("velocity")
+    value = math.radians(limit.velocity)
+    new = number(value)
+    document.set_attribute(document.span(limit.element), "velocity", new)
+    plan.changes.append(Change(_element(joint), limit.element.sourceline or joint.line, "limit velocity", old, new,
+                               f"{VELOCITY_DEGREES}: deg/s, converted to rad/s (x pi/180)"))
+    _record(plan, joint, velocity=float(new))
 
 
 def _normalise_axis(document: Document, plan: FixPlan, joint) -> None:
@@ -243,9 +276,10 @@ FIXER = Fixer[JointsOptions]("fix-joints", plan_joints, verify, options=JointsOp
                              help="""\
 Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
 
-Inverted limits (J003) are swapped; revolute limits in degrees (J005) become radians; a
-non-unit axis (J010) is normalised; a `<limit>` without effort or velocity (J007) gets them
-from --limits-from or --effort/--velocity. A zero axis (J009) cannot be fixed automatically:
-it is reported, with what to do. Only the changed attributes are edited.
+Inverted limits (J003) are swapped; revolute limits in degrees (J005), a joint origin's rpy in
+degrees (J015) and a velocity in deg/s (J016) become radians; a non-unit axis (J010) is
+normalised; a `<limit>` without effort or velocity (J007) gets them from --limits-from or
+--effort/--velocity. A zero axis (J009) cannot be fixed automatically: it is reported, with what
+to do. Only the changed attributes are edited.
 """)
 """``ar3cli fix-joints``: :func:`plan_joints`, then :func:`verify` with ``--verify``."""

@@ -13,6 +13,18 @@ ONE_LINE_LIST = 12
 """Name lists longer than this are cut in the summary lines (the JSON has them all)."""
 
 
+def library_report(path, library) -> Report:
+    """The Report for a xacro library (:class:`~ar3cli.urdf.macro_library.MacroLibrary`): one line, not
+    tables of a robot that is not there (no name, no links)."""
+    where = (f"; run ar3cli info on the file that includes it: {', '.join(library.included_by)}"
+             if library.included_by else "; run ar3cli info on the entry file that includes it")
+    data = {"path": str(path), "macro_library": {"macros": list(library.macros), "properties": library.properties,
+                                                 "materials": library.materials,
+                                                 "included_by": list(library.included_by)}}
+    return Report(data=data, lines=[f"{path}: a xacro library, not a robot: it {library.describe()} and "
+                                    f"instantiates none{where}"])
+
+
 def report(summary: Summary, tree: bool = True, torques: TorqueCheck | None = None,
            picture: str | None = None) -> Report:
     """The Report for ``summary``; ``tree=False`` leaves the rich Tree out (JSON needs no rich).

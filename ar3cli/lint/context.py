@@ -2,23 +2,56 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
+from dataclasses import dataclass
 from typing import Any, TypeVar
 
+from ar3cli.maths.tensor_math import symmetric_eigenvalues
 from ar3cli.urdf.bounds import Box, link_bounds, scaled_mesh_bounds, shape_bounds
 from ar3cli.urdf.model import Link, Model, Shape
 
 T = TypeVar("T")
+Matrix = tuple[tuple[float, float, float], ...]
+IDENTITY: Matrix = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+
+
+@dataclass(frozen=True)
+class RigidBody:
+    """Links welded together by fixed joints, as every engine simulates them: one body (MuJoCo fuses
+    them, PyBullet's and Drake's articulated solvers carry their inertia together).
+
+    ``top`` is the member whose parent joint moves (or the root); ``moments`` are the principal
+    moments of the members' composite inertia about their common centre of mass (parallel-axis terms
+    included), ascending; NaN when a member's numbers are not finite.
+    """
+
+    top: str
+    members: tuple[str, ...]
+    mass: float
+    moments: tuple[float, float, float]
+
+
+def _matmul(a: Matrix, b: Matrix) -> Matrix:
+    return tuple(tuple(sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)) for i in range(3))  # type: ignore[return-value]
+
+
+def _apply(rotation: Matrix, vector, translation=(0.0, 0.0, 0.0)) -> tuple[float, float, float]:
+    return tuple(sum(rotation[i][k] * vector[k] for k in range(3)) + translation[i] for i in range(3))  # type: ignore[return-value]
 
 
 class Context:
     """The model a rule checks, with the link boxes and the PyBullet session built once per file
     and shared by every rule that asks (pybullet is imported only when a ``--sim`` rule does)."""
 
-    def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset()) -> None:
+    def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset(),
+                 targets: tuple[str, ...] = ("pybullet", "ros")) -> None:
         self.model = model
         self.srdf_disabled = srdf_disabled
         """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf_read.is_disabled`)."""
+        self.targets = targets
+        """The engines the robot is meant for (``lint-urdf --target``): a rule whose verdict depends on
+        the engine (a mesh MuJoCo finds through its own ``meshdir``) asks here."""
         self._bounds: dict[str, Box | None] = {}
         self._shape_bounds: dict[int, Box | None] = {}
         self._mesh_bounds: dict[tuple, Box | None] = {}
@@ -57,6 +90,91 @@ class Context:
         if key not in self._mesh_bounds:
             self._mesh_bounds[key] = scaled_mesh_bounds(geometry)
         return self._mesh_bounds[key]
+
+    def link_size(self, link: Link) -> float | None:
+        """The diagonal of the link's box (:meth:`link_bounds`) in metres, or None without one."""
+        box = self.link_bounds(link)
+        return None if box is None else math.dist(box[0], box[1])
+
+    def robot_scale(self) -> float | None:
+        """The median size (:meth:`link_size`) of the robot's links that have geometry: what "small"
+        and "far" mean for this robot (a hand's links are centimetres, a truck's metres), so that
+        the plausibility rules judge a value against the robot itself rather than one constant."""
+        if "robot-scale" not in self._shared:
+            sizes = sorted(size for link in self.model.links if (size := self.link_size(link)) is not None
+                           and size > 0 and math.isfinite(size))
+            self._shared["robot-scale"] = sizes[len(sizes) // 2] if sizes else None
+        return self._shared["robot-scale"]
+
+    def total_mass(self) -> float:
+        """The sum of the links' positive, finite masses (kg)."""
+        if "total-mass" not in self._shared:
+            self._shared["total-mass"] = sum(mass for link in self.model.links if link.inertial is not None
+                                             and (mass := link.inertial.mass) is not None and math.isfinite(mass)
+                                             and mass > 0)
+        return self._shared["total-mass"]
+
+    def rigid_body(self, link: Link) -> RigidBody:
+        """The :class:`RigidBody` ``link`` belongs to: the groups are found once per file, a group's
+        composite inertia the first time one of its links is asked about (few files need any)."""
+        if "rigid-groups" not in self._shared:
+            self._shared["rigid-groups"] = self._rigid_groups()
+        placed, groups, bodies = self._shared["rigid-groups"]
+        top = placed[link.name][0]
+        if top not in bodies:
+            bodies[top] = RigidBody(top, tuple(groups[top]), *self._composite(groups[top], placed))
+        return bodies[top]
+
+    def _rigid_groups(self) -> tuple[dict, dict[str, list[str]], dict[str, RigidBody]]:
+        """(each link's (top, rotation, origin) in the frame of the top of its chain of fixed joints (a
+        loop in a broken file ends the walk), top -> its members, an empty cache of bodies)."""
+        model = self.model
+        placed: dict[str, tuple[str, Matrix, tuple[float, float, float]]] = {}
+        for link in model.links:
+            chain, name, seen = [], link.name, set()
+            while name not in placed and name not in seen:
+                seen.add(name)
+                joint = model.parent_joint(name)
+                if joint is None or joint.type != "fixed" or joint.parent is None or model.link(joint.parent) is None:
+                    placed[name] = (name, IDENTITY, (0.0, 0.0, 0.0))
+                    break
+                chain.append((name, joint))
+                name = joint.parent
+            for child, joint in reversed(chain):
+                top, rotation, origin = placed.get(joint.parent, (joint.parent, IDENTITY, (0.0, 0.0, 0.0)))
+                placed[child] = (top, _matmul(rotation, joint.origin.rotation), _apply(rotation, joint.origin.xyz, origin))
+        groups: dict[str, list[str]] = {}
+        for link in model.links:
+            groups.setdefault(placed[link.name][0], []).append(link.name)
+        return placed, groups, {}
+
+    def _composite(self, members, placed) -> tuple[float, tuple[float, float, float]]:
+        """(mass, principal moments about the common COM) of ``members`` placed in their top's frame."""
+        parts = []
+        for name in members:
+            inertial = self.model.link(name).inertial  # type: ignore[union-attr]
+            mass = inertial.mass if inertial is not None else None
+            if mass is None or not mass > 0:
+                continue
+            _top, rotation, origin = placed[name]
+            tensor = inertial.tensor or (0.0,) * 6  # type: ignore[union-attr]
+            ixx, ixy, ixz, iyy, iyz, izz = tensor
+            frame = _matmul(rotation, inertial.origin.rotation)  # type: ignore[union-attr]
+            local = ((ixx, ixy, ixz), (ixy, iyy, iyz), (ixz, iyz, izz))
+            turned = _matmul(_matmul(frame, local), tuple(zip(*frame)))  # type: ignore[arg-type]
+            parts.append((mass, _apply(rotation, inertial.origin.xyz, origin), turned))  # type: ignore[union-attr]
+        total = sum(mass for mass, _c, _i in parts)
+        if not total > 0 or not math.isfinite(total):
+            return total, (0.0, 0.0, 0.0)
+        centre = [sum(mass * c[i] for mass, c, _ in parts) / total for i in range(3)]
+        composite = [[0.0] * 3 for _ in range(3)]
+        for mass, c, turned in parts:
+            d = [c[i] - centre[i] for i in range(3)]
+            square = d[0] ** 2 + d[1] ** 2 + d[2] ** 2
+            for i in range(3):
+                for j in range(3):
+                    composite[i][j] += turned[i][j] + mass * ((square if i == j else 0.0) - d[i] * d[j])
+        return total, symmetric_eigenvalues(composite)
 
     @property
     def session(self) -> Any:

@@ -25,6 +25,7 @@ from ar3cli.findings import Finding, Severity
 from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
+from ar3cli.lint.rules.file import LIBRARY
 
 if TYPE_CHECKING:
     from ar3cli.lint.result_cache import ResultCache
@@ -208,7 +209,7 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
 
     return ResultCache.for_settings(rules=[rule.code for rule in rules], per_file_ignores=options.per_file_ignores,
                                     severity=options.severity, package_paths=options.package_paths,
-                                    xacro_args=options.xacro_args)
+                                    xacro_args=options.xacro_args, targets=options.targets)
 
 
 def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: ResultCache | None = None) -> LintResult:
@@ -253,6 +254,8 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
+    if not model.links and not model.joints and is_macro_library(model):  # a xacro library: one info line (F008)
+        rules = [] if matches(LIBRARY, options.ignore) else [REGISTRY[LIBRARY]]
     static, simulated, in_mujoco = _partition(rules)
     findings = _run_rules(model, shown, static, options)
     error = None
@@ -270,6 +273,13 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
                 error = exc.message
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
+
+
+def is_macro_library(model) -> bool:
+    """Whether ``model``'s file is a xacro library that makes no robot (:mod:`ar3cli.urdf.macro_library`)."""
+    from ar3cli.urdf.macro_library import macro_library
+
+    return macro_library(model, find_includers=False) is not None
 
 
 def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
@@ -291,7 +301,7 @@ _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]]
 
 def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
     """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
-    context = Context(model, options.srdf_disabled)
+    context = Context(model, options.srdf_disabled, options.targets)
     locator = Locator(model, shown)
     file_ignores = _file_level_ignores(model.source_bytes)
     findings: list[Finding] = []
@@ -307,8 +317,8 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> li
                 path, line, column = locator.locate(hit)
                 if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
                     continue
-                findings.append(_override(Finding(rule.code, rule.severity, hit.message, path, line, column,
-                                                  hit.hint or rule.fix), options))
+                findings.append(_override(Finding(rule.code, rule.severity_for(options.targets), hit.message, path, line,
+                                                  column, hit.hint or rule.fix), options))
     finally:
         context.close()
     return findings

@@ -73,10 +73,11 @@ class ResultCache:
     @classmethod
     def for_settings(cls, rules: list[str], per_file_ignores: Mapping[str, list[str]],
                      severity: Mapping[str, Severity], package_paths: Mapping[str, Path],
-                     xacro_args: Mapping[str, str]) -> ResultCache:
+                     xacro_args: Mapping[str, str], targets: tuple[str, ...] = ()) -> ResultCache:
         """The cache for a run with these rule codes and options (package folders made absolute:
-        a relative one means another folder from another working directory)."""
-        return cls(repr((list(rules), sorted(per_file_ignores.items()),
+        a relative one means another folder from another working directory; the target engines set
+        the severity of target-bound rules)."""
+        return cls(repr((list(rules), sorted(targets), sorted(per_file_ignores.items()),
                          sorted((code, level.value) for code, level in severity.items()),
                          sorted((name, os.path.abspath(folder)) for name, folder in package_paths.items()),
                          sorted(xacro_args.items()))))

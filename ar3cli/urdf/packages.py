@@ -124,6 +124,11 @@ class PackageResolver:
             self.probed[key] = path_state(key)
         return path
 
+    def is_file(self, path: Path) -> bool:
+        """Whether ``path`` is a regular file, remembered in :attr:`probed` like every path a resolution
+        looks at (a lint rule that resolves a path its own way, as MuJoCo would, asks here)."""
+        return self._probe(path).is_file()
+
     def _package_name(self, folder: Path) -> str | None:
         manifest = folder / "package.xml"
         self._probe(manifest)

@@ -145,11 +145,13 @@ def _declare_undeclared_prefixes(data: bytes, quirks: list[Quirk]) -> bytes:
     number stay as they are.
     """
     first_use: dict[bytes, int] = {}
+    quoted = _unparsed_spans(data)
     for match in _PREFIXED_TAG.finditer(data):
-        first_use.setdefault(match.group(1), match.start())
+        if not _inside(quoted, match.start()):  # <!-- <xacro:stairs .../> --> declares nothing and needs nothing
+            first_use.setdefault(match.group(1), match.start())
     for match in _PREFIXED_ATTRIBUTE.finditer(data):
         before = _PREFIX_BEFORE.search(data, max(0, match.start() - 200), match.start())
-        if before and _inside_a_tag(data, match.start()):
+        if before and _inside_a_tag(data, match.start()) and not _inside(quoted, match.start()):
             prefix, start = before.group(1), before.start(1)
             first_use[prefix] = min(first_use.get(prefix, start), start)
     declared = set(_DECLARED.findall(data)) | {b"xml", b"xmlns"}
@@ -165,6 +167,38 @@ def _declare_undeclared_prefixes(data: bytes, quirks: list[Quirk]) -> bytes:
     declarations = b"".join(b" xmlns:" + prefix + b'="' + UNDECLARED_NAMESPACE.encode() + prefix + b'"'
                             for prefix in missing)
     return data[:root.end()] + declarations + data[root.end():]
+
+
+_UNPARSED = ((b"<!--", b"-->"), (b"<![CDATA[", b"]]>"))
+"""Where XML text is not markup: comments and CDATA sections."""
+
+
+def _unparsed_spans(data: bytes) -> list[tuple[int, int]]:
+    """(start, end) byte offsets of the comments and CDATA sections, in order (an unclosed one runs to
+    the end: the parser reports it). Linear: each opening is searched for again only once passed."""
+    spans: list[tuple[int, int]] = []
+    upcoming = {opening: data.find(opening) for opening, _closing in _UNPARSED}
+    position = 0
+    while True:
+        for opening, at in upcoming.items():
+            if 0 <= at < position:
+                upcoming[opening] = data.find(opening, position)
+        found = [(at, opening, closing) for opening, closing in _UNPARSED if (at := upcoming[opening]) >= 0]
+        if not found:
+            return spans
+        start, opening, closing = min(found)
+        end = data.find(closing, start + len(opening))
+        end = len(data) if end < 0 else end + len(closing)
+        spans.append((start, end))
+        position = end
+
+
+def _inside(spans: list[tuple[int, int]], offset: int) -> bool:
+    """Whether ``offset`` lies in one of the sorted, disjoint ``spans``."""
+    import bisect
+
+    index = bisect.bisect_right(spans, (offset, float("inf"))) - 1
+    return index >= 0 and offset < spans[index][1]
 
 
 def _inside_a_tag(data: bytes, offset: int) -> bool:

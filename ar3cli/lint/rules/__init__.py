@@ -35,8 +35,16 @@ def matches(code: str, patterns) -> bool:
     return any(pattern == "ALL" or code.startswith(pattern) for pattern in patterns)
 
 
+OPT_IN_CODES: tuple[str, ...] = tuple(rule.code for rule in RULES if rule.opt_in)
+"""The rules that run only when named (they read every collision mesh's triangles)."""
+
+
 def validate_patterns(patterns, where: str) -> list[str]:
-    """Upper-case the patterns and check each one selects at least one rule; ValueError otherwise."""
+    """Upper-case the patterns and check each one selects at least one rule; ValueError otherwise.
+
+    ``ALL`` written by the user means every rule: the opt-in ones are named after it (a default
+    selection, which nobody wrote, leaves them out).
+    """
     cleaned = []
     for raw in patterns:
         pattern = str(raw).strip().upper()
@@ -45,4 +53,6 @@ def validate_patterns(patterns, where: str) -> list[str]:
         if pattern != "ALL" and not any(code.startswith(pattern) for code in REGISTRY):
             raise ValueError(f"{where}: unknown rule code {raw!r} (codes look like F001, J006, or a prefix like J)")
         cleaned.append(pattern)
+    if "ALL" in cleaned:
+        cleaned += [code for code in OPT_IN_CODES if code not in cleaned]
     return cleaned

@@ -34,6 +34,15 @@ order of the registry, docs/rules.md and every listing (:data:`FAMILY_ORDER`).""
 FAMILY_ORDER = "".join(FAMILIES)
 """The family prefixes in registry order: ``"FSJIGPMT"``."""
 
+ENGINES = ("pybullet", "ros", "mujoco", "isaac", "drake", "gazebo")
+"""The engines and tools a rule can be about, by the names ``lint-urdf --target`` takes: ``ros`` stands
+for urdfdom and everything built on it (check_urdf, robot_state_publisher, RViz, MoveIt, KDL)."""
+EVERY_ENGINE = "any"
+"""A rule about the file's meaning in every consumer (a typed degree, a missing mesh): never target-bound."""
+ENGINE_NAMES = {"pybullet": "PyBullet", "ros": "ROS (urdfdom)", "mujoco": "MuJoCo", "isaac": "Isaac Sim",
+                "drake": "Drake", "gazebo": "Gazebo", EVERY_ENGINE: "every engine"}
+"""How docs/rules.md names each engine."""
+
 
 @dataclass(frozen=True)
 class Hit:
@@ -83,10 +92,35 @@ class Rule:
     opt_in: bool = False
     targets: tuple[str, ...] = ()
     """The engines (``lint-urdf --target``) whose traps this rule reports; empty for every engine."""
+    engines: tuple[str, ...] = (EVERY_ENGINE,)
+    """What the finding is about: the engines and tools (:data:`ENGINES`) in which its consequence
+    happens, or :data:`EVERY_ENGINE`. A rule that names engines only is target-bound: when
+    ``--target`` names none of them its findings are infos (:meth:`severity_for`)."""
+    breaks: str | None = None
+    """For an error: which engine or tool refuses the file or measurably misbehaves on it, and how (the
+    severity policy of docs/rules.md; ``tests/test_severity_policy.py`` holds every error rule to it)."""
+    refused_by: tuple[str, ...] = ()
+    """The engines (:data:`ENGINES`) that refuse to load a file with this finding: P001 and M001, which
+    load it, stay quiet about a refusal a static rule already explains."""
 
     @property
     def family(self) -> str:
         return FAMILIES[self.code[0]]
+
+    @property
+    def target_bound(self) -> bool:
+        """True when the finding matters only to the engines the rule names (not every engine), so
+        its severity follows ``--target``. Simulation rules are about the engine ``--engine`` chose, T
+        rules run only for their targets (or when their code is named, which chooses the engine)."""
+        return EVERY_ENGINE not in self.engines and not self.needs_sim and not self.targets
+
+    def severity_for(self, targets) -> Severity:
+        """The severity of this rule's findings for a robot meant for ``targets``: the declared one,
+        or info for a target-bound rule none of whose engines is a target (PyBullet's 1 kg default,
+        I002, is noise to a ROS-only robot)."""
+        if self.target_bound and not set(self.engines) & set(targets):
+            return Severity.INFO
+        return self.severity
 
     @property
     def anchor(self) -> str:
@@ -118,10 +152,12 @@ def registered() -> tuple[Rule, ...]:
 def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str, bad: str, good: str,
          needs_sim: bool = False, fixed_by: str | None = None, thresholds: str | None = None,
          references: str | None = None, opt_in: bool = False,
-         targets: tuple[str, ...] = ()) -> Callable[[Check | None], Rule]:
+         targets: tuple[str, ...] = (), engines: tuple[str, ...] | None = None, breaks: str | None = None,
+         refused_by: tuple[str, ...] = ()) -> Callable[[Check | None], Rule]:
     """Decorator turning a check function into a :class:`Rule` and registering it: a rule written
     anywhere in the ``ar3cli.lint.rules`` package is in the engine, the docs and the tests (the
-    function's name is unused)."""
+    function's name is unused). ``engines`` defaults to the rule's ``targets`` (a T rule is about its
+    engines), else to every engine."""
 
     def wrap(check: Check | None) -> Rule:
         return _register(Rule(code=code, name=name, severity=Severity(severity), title=title,
@@ -130,7 +166,8 @@ def rule(code: str, name: str, severity: str, title: str, *, why: str, fix: str,
                               check=check, needs_sim=needs_sim, fixed_by=fixed_by,
                               thresholds=" ".join(thresholds.split()) if thresholds else None,
                               references=" ".join(references.split()) if references else None, opt_in=opt_in,
-                              targets=targets))
+                              targets=targets, engines=engines or targets or (EVERY_ENGINE,),
+                              breaks=" ".join(breaks.split()) if breaks else None, refused_by=refused_by))
 
     return wrap
 
@@ -150,6 +187,17 @@ def dedent(text: str) -> str:
     if margin:
         lines = [line[margin:] for line in lines]
     return "\n".join(lines)
+
+
+def refusal_explained(ctx, engine: str) -> str | None:
+    """The code of a static rule that fires on this file and says ``engine`` refuses it (its
+    ``refused_by``), or None: P001 and M001, which load the file, then add nothing to the static
+    finding that already names the cause at its line (one cause, one finding)."""
+    for rule in registered():  # every rule: the package imported all its modules before any rule runs
+        if engine in rule.refused_by and not rule.needs_sim and rule.check is not None:
+            for _hit in rule.check(ctx):
+                return rule.code
+    return None
 
 
 def engine_rule(code: str, name: str, severity: str, title: str, **docs: str) -> Rule:

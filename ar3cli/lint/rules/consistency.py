@@ -12,6 +12,7 @@ import math
 from collections.abc import Iterator
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
+from ar3cli.lint.rules.geometry import scale_mismatches
 from ar3cli.urdf.bounds import Box, box_around, box_union
 
 DETACHED_FACTOR = 1.0
@@ -199,7 +200,7 @@ def collision_off(ctx, link) -> tuple[float, float, Box, Box] | None:
     not to blame when only the collision is off (alex_nub_hands.urdf's nubs: ``<origin xyz="0 1.57 0">``,
     the rpy typed into xyz)."""
     found = collision_offset(ctx, link)
-    if found is None:
+    if found is None or scale_mismatches(ctx, link):  # a mesh in the wrong unit is G006's
         return None
     covered, offset, visual, _collision = found
     return found if covered < COVER_MIN and offset > max(OFFSET_MIN, OFFSET_FACTOR * _diagonal(visual) / 2) else None

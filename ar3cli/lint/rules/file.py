@@ -11,6 +11,7 @@ from ar3cli.lint.rules.base import Hit, engine_rule, robot, rule
 
 unreadable = engine_rule(
     "F001", "unreadable", "error", "File cannot be read",
+    breaks="No engine or tool can read the file: nothing else is checked.",
     why="The path is missing, a directory, a pipe or device, too large, or not readable; nothing else can "
         "be checked.",
     fix="Check the path and its permissions.",
@@ -18,6 +19,7 @@ unreadable = engine_rule(
 
 not_xml = engine_rule(
     "F002", "not-xml", "error", "File is not well-formed XML",
+    breaks="urdfdom, PyBullet, MuJoCo and every XML parser refuse the file.",
     why="Every URDF consumer parses XML first; a syntax error (or an empty file, binary junk, or an "
         "entity declaration, which ar3cli refuses because entities can explode or read other files) "
         "stops all of them.",
@@ -27,6 +29,7 @@ not_xml = engine_rule(
 
 not_robot = engine_rule(
     "F003", "not-robot", "error", "Root element is not <robot>",
+    breaks="urdfdom and PyBullet refuse a file whose root element is not <robot>.",
     why="A URDF's root element must be <robot>; an SDF, MJCF or other XML file is not a URDF.",
     fix="Lint only URDF files, or convert the file to URDF.",
     bad='<?xml version="1.0"?>\n<sdf version="1.6"><model name="m"/></sdf>',
@@ -34,6 +37,7 @@ not_robot = engine_rule(
 
 xacro_failed = engine_rule(
     "F004", "xacro-failed", "error", "Xacro expansion failed",
+    breaks="xacro stops: no URDF comes out for any tool.",
     why="A .xacro file must expand before it can be checked; undefined properties, missing includes "
         "or unknown packages stop the expansion.",
     fix="Pass --xacro-arg NAME:=VALUE / --package-path NAME=DIR, or fix the xacro at the reported place.",
@@ -46,6 +50,7 @@ _PORTABILITY_QUIRKS = ("version-", "leading-junk", "trailing-junk", "undeclared-
 
 
 @rule("F005", "strict-parser", "warning", "File needs a tolerant XML parser",
+      engines=("ros",),
       why="""Strict parsers (urdfdom's TinyXML2, Python's xml.etree, ROS tools) reject
       version="0.0" declarations, blank lines or junk before the declaration, and bytes after the
       root element; namespace-aware ones (lxml, ROS 2 launch, xacro) reject an element prefix that
@@ -63,10 +68,15 @@ def strict_parser(ctx) -> Iterator[Hit]:
             yield Hit(quirk.message, line=quirk.line, hint=hint)
 
 
-_SUBSTITUTION = re.compile(r"\$\(|\$\{")
+SUBSTITUTION = re.compile(r"\$\(|\$\{")
+"""An unexpanded xacro or roslaunch substitution: ``$(find pkg)``, ``${var}`` (F006's; the mesh rules leave
+such paths alone, and F007 such numbers)."""
 
 
 @rule("F006", "unexpanded-substitution", "error", "Unexpanded $(...) or ${...} substitution",
+      refused_by=("ros", "pybullet"),
+      breaks="Every parser reads the text literally: urdfdom refuses a substituted number, and PyBullet cannot "
+             "find a substituted mesh path and refuses the file.",
       why="""A URDF containing $(find pkg) or ${var} was written from a xacro file without
       expanding it (or by a broken generator); every URDF parser reads the text literally, so
       mesh paths and numbers are wrong.""",
@@ -81,9 +91,22 @@ def unexpanded_substitution(ctx) -> Iterator[Hit]:
         if not isinstance(element.tag, str):
             continue
         for key, value in element.attrib.items():
-            if _SUBSTITUTION.search(value):
-                yield Hit(f"<{element.tag} {key}=\"{value}\"> contains an unexpanded substitution", element,
+            if SUBSTITUTION.search(value):
+                consequence = (": no tool can find the mesh (PyBullet refuses the file)"
+                               if element.tag == "mesh" and key == "filename" else "")
+                yield Hit(f"<{qualified_name(element, element.tag)} {qualified_name(element, key)}=\"{value}\"> "
+                          f"contains an unexpanded substitution{consequence}", element,
                           hint=XACRO_SOURCE_HINT if xacro_source else None)
+
+
+def qualified_name(element, name: str) -> str:
+    """``name`` (a tag or an attribute of ``element``) as written, ``xacro:macro``, rather than lxml's Clark
+    notation ``{http://www.ros.org/wiki/xacro}macro``."""
+    if not name.startswith("{"):
+        return name
+    uri, _, local = name[1:].partition("}")
+    prefix = next((key for key, value in (element.nsmap or {}).items() if value == uri and key), None)
+    return f"{prefix}:{local}" if prefix else local
 
 
 XACRO_SOURCE_HINT = ("This file is a xacro source (it holds <xacro:...> elements): rename it to .xacro (or "
@@ -135,6 +158,8 @@ def number_problem(text: str, count: int) -> str | None:
 
 
 @rule("F007", "malformed-number", "error", "Malformed number or wrong number of components",
+      refused_by=("ros",),
+      breaks="urdfdom refuses the file; PyBullet silently reads zeros, and nan or inf become NaN states.",
       why="""xyz/rpy/size/scale need exactly three numbers, rgba four, masses and limits one.
       Parsers disagree on what to do with "0 0" or "1,0,0": urdfdom refuses the file, PyBullet
       silently reads zeros, and nan or inf propagate into the physics as NaN states.""",
@@ -147,7 +172,7 @@ def malformed_number(ctx) -> Iterator[Hit]:
         found = []
         for key, text in element.items():  # the attributes written (one or two), not every one the spec has
             count = spec.get(key)
-            if count is None or ("$" in text and _SUBSTITUTION.search(text)):
+            if count is None or ("$" in text and SUBSTITUTION.search(text)):
                 continue  # unexpanded substitutions are F006's
             problem = number_problem(text, count)
             if problem:
@@ -157,3 +182,38 @@ def malformed_number(ctx) -> Iterator[Hit]:
             found.sort(key=lambda item: order.index(item[0]))  # reported in the spec's order, as ever
         for key, text, problem in found:
             yield Hit(f"<{element.tag} {key}=\"{text}\"> {problem}", element)
+
+
+LIBRARY = "F008"
+"""The code of a xacro library's one line (:func:`macro_library_file`): the engine runs it alone on such a file."""
+
+
+@rule(LIBRARY, "macro-library", "info", "A xacro library: macros, no robot",
+      why="""A robot's urdf/ folder holds one entry file and files that only define xacro macros (or
+      properties, or materials) for it to include: leg.xacro, utils/*.xacro, materials.xacro. Such a
+      file instantiates no robot, so it has no name, no links and no joints of its own, and every
+      robot rule would call it broken. Its content is checked where an entry file includes it: the
+      entry file's findings point at this file's lines. This one line says so, and names the files of
+      its package that include it.""",
+      fix="Nothing to fix here: lint the entry file that includes it (lint-urdf on the folder does).",
+      bad='''<?xml version="1.0"?>
+<robot xmlns:xacro="http://www.ros.org/wiki/xacro">
+  <xacro:property name="length" value="0.3"/>
+  <xacro:macro name="segment" params="name">
+    <link name="${name}"/>
+  </xacro:macro>
+</robot>
+''',
+      good=robot('<link name="base"/>'),
+      thresholds="A file that makes no link and no joint, whose top level holds only xacro macro, property, arg and "
+                 "include elements (also inside if/unless) and <material>s, and at least one macro, property or material. "
+                 "The files that include it are looked for in its package (at most 400 files).")
+def macro_library_file(ctx) -> Iterator[Hit]:
+    from ar3cli.urdf.macro_library import macro_library
+
+    library = macro_library(ctx.model)
+    if library is not None:
+        where = (f"included by {', '.join(library.included_by)}" if library.included_by
+                 else "no file of its package was found to include it")
+        yield Hit(f"{library.describe()} and instantiates no robot: a xacro library, checked where an entry file "
+                  f"includes it ({where})", ctx.model.root)

@@ -8,6 +8,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
+from ar3cli.lint.rules.file import SUBSTITUTION
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 
 MAX_PLAUSIBLE_EXTENT = 5.0
@@ -34,9 +35,11 @@ def _path_facts(name: str) -> tuple[bool, str]:
 
 
 def _meshes(ctx):
-    """(link, shape, geometry) for every mesh with a filename."""
+    """(link, shape, geometry) for every mesh with a filename; a filename holding an unexpanded
+    substitution (``$(find pkg)/x.stl``) is F006's alone: one cause, one finding."""
     for link, shape in ctx.model.meshes():
-        if shape.geometry.filename:
+        filename = shape.geometry.filename
+        if filename and not ("$" in filename and SUBSTITUTION.search(filename)):
             yield link, shape, shape.geometry
 
 
@@ -51,22 +54,53 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
 
 
 @rule("G001", "mesh-not-found", "error", "Mesh file not found",
+      refused_by=("pybullet", "mujoco"),
+      breaks='PyBullet refuses the file ("Cannot load URDF file"); RViz and MoveIt draw and collide nothing for '
+             "the link.",
       why="""PyBullet refuses the whole file with "Cannot load URDF file" (the real reason, the missing
       mesh, only goes to C stdout); RViz shows nothing. ar3cli resolves package:// like ROS
       (--package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, package.xml in ancestors) and relative
-      paths like PyBullet, and lists every place it looked.""",
+      paths like PyBullet, and lists every place it looked. MuJoCo looks elsewhere: in the
+      <mujoco><compiler meshdir> of the file, by the mesh's base name; for a robot meant for MuJoCo
+      only (--target mujoco) a mesh found there is not reported.""",
       fix="Fix the path, or tell ar3cli where the package is with --package-path NAME=DIR.",
-      bad=_mesh_robot("meshes/missing.stl"), good=_mesh_robot("meshes/base.stl"))
+      bad=_mesh_robot("meshes/missing.stl"), good=_mesh_robot("meshes/base.stl"),
+      references="MuJoCo src/xml/xml_urdf.cc (mesh file names stripped to their base name, looked up in "
+                 "<mujoco><compiler meshdir>).")
 def mesh_not_found(ctx) -> Iterator[Hit]:
+    meshdir = ctx.shared("mujoco-meshdir", mujoco_meshdir) if "mujoco" in ctx.targets else None
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
             tried = "; looked in " + ", ".join(resolution.tried) if resolution.tried else ""
-            yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{tried}",
+            also = ""
+            if meshdir is not None and ctx.model.resolver.is_file(meshdir / _base_name(resolution.uri)):
+                others = [target for target in ctx.targets if target != "mujoco"]
+                if not others:
+                    continue  # MuJoCo, the only target, finds it through its own meshdir
+                also = f" (only MuJoCo finds it, in its <compiler meshdir> {meshdir})"
+            yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{also}{tried}",
                       geometry.element)
 
 
+def mujoco_meshdir(model) -> Path | None:
+    """The folder MuJoCo looks for this file's meshes in: ``<mujoco><compiler meshdir="..."/>`` under
+    ``<robot>``, relative to the file's folder; None without one."""
+    for block in model.root.findall("mujoco"):
+        for compiler in block.findall("compiler"):
+            folder = compiler.get("meshdir")
+            if folder and folder.strip():
+                return model.resolver.base_dir / folder.strip()
+    return None
+
+
+def _base_name(uri: str) -> str:
+    """The mesh's file name as MuJoCo's URDF import keeps it: everything after the last slash."""
+    return uri.strip().replace("\\", "/").rsplit("/", 1)[-1]
+
+
 @rule("G002", "empty-package", "error", "package:/// URI with an empty package name",
+      engines=("ros",), breaks="ROS (RViz, MoveIt, Gazebo) cannot resolve the URI: the link has no mesh there.",
       why="""package:///meshes/x.stl has an empty package name (three slashes). ROS cannot resolve it;
       PyBullet only finds the file by its fallback search relative to the URDF.""",
       fix="Write package://PACKAGE_NAME/meshes/x.stl, or a path relative to the URDF.",
@@ -79,18 +113,22 @@ def empty_package(ctx) -> Iterator[Hit]:
 
 
 @rule("G003", "absolute-path", "warning", "Absolute mesh path",
-      why="An absolute path (/home/me/... or file:///...) works on one machine only.",
+      why="""An absolute path (/home/me/... or file:///...) works on one machine only. file://meshes/x.stl
+      (two slashes) is not absolute: PyBullet and ar3cli read the rest as a path next to the URDF.""",
       fix="Use package://PACKAGE/... or a path relative to the URDF file.",
       bad=_mesh_robot("/home/me/robot/meshes/base.stl"), good=_mesh_robot("meshes/base.stl"),
       fixed_by="fix-mesh-paths --package NAME=DIR")
 def absolute_path(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         name = geometry.filename.strip()
-        if name.startswith("file://") or _path_facts(name)[0]:
+        if _path_facts(name.removeprefix("file://"))[0]:  # file:///a is /a; file://meshes/a is meshes/a
             yield Hit(f"link '{link.name}' mesh {name} is an absolute path", geometry.element)
 
 
 @rule("G004", "mesh-format", "error", "Mesh format PyBullet cannot load",
+      engines=("pybullet", "mujoco"),
+      refused_by=("pybullet", "mujoco"),
+      breaks='PyBullet refuses the file ("invalid mesh filename extension"); MuJoCo cannot read the mesh either.',
       why="""PyBullet loads .stl, .obj and .dae meshes only; a .ply or Ogre .mesh makes it refuse the
       whole file ("invalid mesh filename extension").""",
       fix="Convert the mesh to .stl or .obj (e.g. with trimesh or MeshLab).",
@@ -106,6 +144,7 @@ def mesh_format(ctx) -> Iterator[Hit]:
 
 
 @rule("G005", "lfs-pointer", "error", "Mesh is a Git LFS pointer file",
+      breaks="Every mesh loader gets a 130-byte text file: PyBullet reports a corrupt or empty mesh.",
       why="""The repository stores meshes in Git LFS and they were never pulled: the file is a
       130-byte text pointer. Loaders report a corrupt or empty mesh, or crash.""",
       fix="Run git lfs install && git lfs pull in the repository.",
@@ -123,17 +162,33 @@ def lfs_pointer(ctx) -> Iterator[Hit]:
       why="""URDF meshes are in metres. A mesh exported in millimetres loads silently 1000x too large
       in PyBullet (a 30 cm link becomes 300 m); one scaled twice becomes sub-millimetre. Flat meshes
       (ground planes, walls) are exempt. A COLLADA file states its own unit (<unit meter="0.0254"/>
-      for inches), which PyBullet and assimp (RViz, MoveIt) apply: the size is judged after it.""",
+      for inches), which PyBullet and assimp (RViz, MoveIt) apply: the size is judged after it. Judged
+      against the link itself too: a collision mesh about 1000 times larger or smaller than its own
+      visual (a scale="0.001" kept on one and not the other) is in the other unit, whatever its size;
+      the one further from the robot's typical link size is the one reported.""",
       fix='Add scale="0.001 0.001 0.001" for a millimetre mesh, or re-export it in metres.',
       bad=_mesh_robot("meshes/base_mm.stl"), good=_mesh_robot("meshes/base_mm.stl", "0.001 0.001 0.001"),
       thresholds="Largest extent after scale (and COLLADA unit) above MAX_PLAUSIBLE_EXTENT = 5 m with the smallest "
-                 "above FLAT_RATIO = 0.01 of it, or below MIN_PLAUSIBLE_EXTENT = 1 mm.",
+                 "above FLAT_RATIO = 0.01 of it, or below MIN_PLAUSIBLE_EXTENT = 1 mm; or a link's collision meshes "
+                 "SCALE_MISMATCH = 250 to 4000 times larger or smaller than its visual meshes (box diagonals).",
       references="PyBullet LoadMeshFromCollada.cpp (applies <unit meter>); COLLADA 1.4.1 spec, <asset>/<unit>.")
 def mesh_units(ctx) -> Iterator[Hit]:
     from ar3cli.urdf.meshinfo import collada_unit
 
+    judged: set[int] = set()  # meshes whose unit their own link's other meshes already showed
+    for link in ctx.model.links:
+        for shape, factor, ratio, other in scale_mismatches(ctx, link):
+            judged.add(id(shape.geometry.element))
+            scale = " ".join(number_text(v * factor) for v in shape.geometry.params.get("scale") or (1.0, 1.0, 1.0))
+            looks = "like millimetres" if factor < 1 else "scaled to metres twice"
+            yield Hit(f"link '{link.name}' {shape.role} mesh {shape.geometry.filename} is {ratio:.0f}x "
+                      f"{'larger' if factor < 1 else 'smaller'} than the link's {other} mesh: it looks {looks}, its "
+                      f"{other} is in metres (scale=\"{scale}\"?)", shape.geometry.element,
+                      hint=f'Write scale="{scale}" on this mesh, as its {other} says.')
     seen: set[tuple] = set()
     for link, _shape, geometry in _meshes(ctx):
+        if id(geometry.element) in judged:
+            continue
         bounds = ctx.scaled_mesh_bounds(geometry)
         if bounds is None:
             continue
@@ -159,7 +214,94 @@ def mesh_units(ctx) -> Iterator[Hit]:
                       geometry.element, hint="Check the scale attribute: the mesh may already be in metres.")
 
 
+SCALE_MISMATCH = (250.0, 4000.0)
+"""A link's collision meshes this many times larger or smaller than its visual meshes (box diagonals): one
+of the two is in millimetres and the other in metres (G006)."""
+
+
+def scale_mismatches(ctx, link) -> list[tuple[object, float, float, str]]:
+    """(mesh shape at fault, the factor its scale needs, how many times off it is, the role it disagrees with)
+    for each of the link's meshes that is about 1000x (:data:`SCALE_MISMATCH`) larger or smaller than its
+    counterpart of the other role: the visual mesh of the same file for a collision mesh, else the link's
+    visual meshes together. Of the two, the one whose size is further from the median of the robot's other
+    links is at fault; with no other link to compare with, the one outside the sizes a part can have
+    (MIN_PLAUSIBLE_EXTENT to MAX_PLAUSIBLE_EXTENT), else the collision (people look at the visual, not at
+    the collision). Empty when the link's visual and collision meshes agree."""
+    visuals = [shape for shape in link.visuals if shape.geometry.kind == "mesh"]
+    collisions = [shape for shape in link.collisions if shape.geometry.kind == "mesh"]
+    if not visuals or not collisions:
+        return []
+    scale = _median_of_others(ctx, link)
+    found: dict[int, tuple[object, float, float, str]] = {}
+    for collision in collisions:
+        twin = [v for v in visuals if _same_file(v.geometry, collision.geometry)]
+        counterpart = twin or visuals
+        sizes = [_size([ctx.shape_bounds(collision)]), _size([ctx.shape_bounds(shape) for shape in counterpart])]
+        if None in sizes:
+            continue
+        ratio = max(sizes) / min(sizes)
+        if not SCALE_MISMATCH[0] <= ratio <= SCALE_MISMATCH[1]:
+            continue
+        big_is_collision = sizes[0] > sizes[1]
+        big, small = max(sizes), min(sizes)
+        if scale is not None:
+            blame_big = abs(math.log(big / scale)) >= abs(math.log(small / scale))
+        else:
+            plausible = [MIN_PLAUSIBLE_EXTENT <= size <= MAX_PLAUSIBLE_EXTENT for size in (big, small)]
+            blame_big = big_is_collision if plausible[0] == plausible[1] else not plausible[0]
+        factor = 1e-3 if blame_big else 1e3
+        if blame_big == big_is_collision:
+            found.setdefault(id(collision), (collision, factor, ratio, "visual"))
+        else:
+            for shape in counterpart:
+                found.setdefault(id(shape), (shape, factor, ratio, "collision"))
+    return list(found.values())
+
+
+def _median_of_others(ctx, link) -> float | None:
+    """The median size (:meth:`Context.link_size`) of the robot's links other than ``link``: the sizes
+    sorted once per file, this link's taken out by index (a 20,000-link robot asks for every link)."""
+    import bisect
+
+    sizes = ctx.shared("link-sizes", lambda model: sorted(
+        size for other in model.links if (size := ctx.link_size(other)) and math.isfinite(size)))
+    own = ctx.link_size(link)
+    index = bisect.bisect_left(sizes, own) if own and math.isfinite(own) else None
+    count = len(sizes) - (index is not None)
+    if count <= 0:
+        return None
+    middle = count // 2
+    return sizes[middle + 1] if index is not None and middle >= index else sizes[middle]
+
+
+def _same_file(a, b) -> bool:
+    """Two mesh geometries that name the same file (resolved, else as written)."""
+    if a.resolution is not None and b.resolution is not None and a.resolution.found and b.resolution.found:
+        return a.resolution.path == b.resolution.path
+    return (a.filename or "").strip() == (b.filename or "").strip()
+
+
+def _size(boxes) -> float | None:
+    """The diagonal of the box around ``boxes``; None when one is unknown or the size is not positive."""
+    if not boxes or any(box is None for box in boxes):
+        return None
+    size = math.dist(*union_box(boxes))
+    return size if size > 0 and math.isfinite(size) else None
+
+
+def union_box(boxes):
+    """The box around ``boxes`` (none of them None)."""
+    return (tuple(min(box[0][i] for box in boxes) for i in range(3)),
+            tuple(max(box[1][i] for box in boxes) for i in range(3)))
+
+
+def number_text(value: float) -> str:
+    """A scale factor as URDF text: 0.001, not 0.0010000000000000002."""
+    return f"{value:.6g}"
+
+
 @rule("G007", "scalar-scale", "warning", "Mesh scale is a single number",
+      engines=("ros",),
       why="""The spec's scale is three numbers. PyBullet accepts one (with "Scale should be a
       vector3"), urdfdom and yourdfpy refuse or misread it.""",
       fix='Repeat it: scale="0.001 0.001 0.001".',
@@ -172,21 +314,48 @@ def scalar_scale(ctx) -> Iterator[Hit]:
                       hint=f'Write scale="{text} {text} {text}".')
 
 
+MARKER_SIZE = 0.1
+"""A link whose visuals are smaller (box diagonal) than this fraction of the robot's median link is a
+marker (a sensor frame drawn as a 1 cm cube, pr2's and Talos' IMU boxes), not a part to collide with."""
+MARKER_MASS = 1e-4
+"""A link lighter than this fraction of the whole robot (or of mass 0) is a frame with a picture (Baxter's
+0.1 g display and camera links, a "nocol" marker sphere), not a body."""
+
+
 @rule("G008", "no-collision", "warning", "Link with visual but no collision geometry",
       why="""A link you can see but that has no <collision> passes through everything in simulation
       (no contacts, no self-collision checks), and PyBullet's default inertia comes from the
-      collision shape, so it falls back to a tiny default box.""",
+      collision shape, so it falls back to a tiny default box. Visuals meant to be passed through are
+      not reported: a zero-size placeholder (<box size="0 0 0"/>), and markers, judged against the
+      robot itself: a link drawn much smaller than its other links, or one that weighs next to
+      nothing against the whole robot.""",
       fix="Add a <collision> (a primitive or a simplified mesh).",
       bad=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual></link>'),
       good=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual>'
-                 '<collision><geometry><box size="1 1 1"/></geometry></collision></link>'))
+                 '<collision><geometry><box size="1 1 1"/></geometry></collision></link>'),
+      thresholds=f"Not reported: every visual of zero volume; visuals whose box diagonal is below MARKER_SIZE = "
+                 f"{MARKER_SIZE:g} of the robot's median link size; a link whose mass is at most MARKER_MASS = "
+                 f"{MARKER_MASS:g} of the robot's.")
 def no_collision(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        if link.visuals and not link.collisions:
+        if link.visuals and not link.collisions and not _pass_through_visual(ctx, link):
             yield Hit(f"link '{link.name}' has {len(link.visuals)} visual shape(s) but no <collision>", link.element)
 
 
+def _pass_through_visual(ctx, link) -> bool:
+    """True for a link whose visuals are a placeholder or a marker (see G008), not a part."""
+    boxes = [ctx.shape_bounds(shape) for shape in link.visuals]
+    if boxes and all(box is not None and math.prod(hi - lo for lo, hi in zip(*box)) == 0 for box in boxes):
+        return True  # <box size="0 0 0"/>: drawn as nothing
+    mass = link.inertial.mass if link.inertial is not None else None
+    if mass is not None and math.isfinite(mass) and 0 <= mass <= MARKER_MASS * ctx.total_mass():
+        return True
+    size, scale = ctx.link_size(link), ctx.robot_scale()
+    return size is not None and scale is not None and size < MARKER_SIZE * scale
+
+
 @rule("G009", "pybullet-only-path", "info", "Mesh found only by PyBullet's fallback search",
+      engines=("ros",),
       why="""The mesh resolves only because PyBullet also looks for package://NAME/x relative to the
       URDF and in every folder above it. ROS (RViz, MoveIt, Gazebo) resolves package://NAME through
       the package index and will not find it.""",
@@ -281,6 +450,9 @@ def _found_meshes(ctx):
 
 
 @rule("G011", "mesh-unreadable", "error", "Mesh file that engines cannot read",
+      engines=("pybullet", "mujoco"),
+      refused_by=("mujoco",),
+      breaks='PyBullet silently drops the shape ("cannot extract mesh", measured); MuJoCo refuses the file.',
       why="""Judged by the file's bytes, not its name. PyBullet reads binary STL only: an ASCII STL,
       a truncated binary STL or one with no triangles loads without the shape ("cannot extract
       mesh", measured with pybullet 3.2.7: the link has no collision and no visual), and MuJoCo
@@ -360,6 +532,7 @@ def mesh_flat(ctx) -> Iterator[Hit]:
 
 
 @rule("G013", "hull-much-larger", "info", "Collision mesh much smaller than its convex hull",
+      engines=("pybullet", "mujoco", "drake"),
       why="""PyBullet (for every moving body), MuJoCo and Drake's point contact collide a mesh as
       its convex hull. A concave part (a gripper's U, a hollow housing, two fingers in one file)
       whose hull is more than twice its volume collides as the filled-in shape: fingers cannot

@@ -7,6 +7,7 @@ from collections.abc import Iterator
 from functools import lru_cache
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.plausibility import density_implausible, grams_evidence
 from ar3cli.maths.tensor_math import is_positive_definite, satisfies_triangle_inequality, symmetric_eigenvalues
 
 IMPLAUSIBLE_FACTOR = 3.0
@@ -35,11 +36,6 @@ def _moving_links(model) -> dict[str, object]:
     return {joint.child: joint for joint in model.joints if joint.moves and joint.child}
 
 
-def _fixed_links(model) -> dict[str, object]:
-    """Link name -> the fixed joint it hangs from (welded to its parent: it never moves by itself)."""
-    return {joint.child: joint for joint in model.joints if joint.type == "fixed" and joint.child}
-
-
 def effectively_zero(moments) -> bool:
     """True when every principal moment is below :data:`EFFECTIVELY_ZERO` in magnitude."""
     return all(abs(m) < EFFECTIVELY_ZERO for m in moments)
@@ -49,6 +45,11 @@ def near_singular(moments) -> bool:
     """True for a positive tensor whose smallest moment is below mjMINVAL or 1e-9 of the largest."""
     smallest, largest = moments[0], moments[-1]
     return 0 < smallest < max(MJ_MINVAL, NEAR_SINGULAR_RATIO * largest) and not effectively_zero(moments)
+
+
+def _valid_body(inertial, moments) -> bool:
+    """A tensor some body could have: positive definite, A + B >= C, not near-singular (else I004, I005, I009)."""
+    return moments[0] > 0 and _triangle_ok(inertial, moments) and not near_singular(moments)
 
 
 def _triangle_ok(inertial, moments) -> bool:
@@ -71,6 +72,9 @@ def _fmt(moments) -> str:
 
 
 @rule("I001", "inertial-missing", "error", "Moving link without <inertial>",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      breaks="PyBullet simulates the link as 1 kg with I = 1 (measured), MuJoCo invents its mass from the "
+             "geometry at water density, Gazebo drops the link.",
       why="""PyBullet gives a link without <inertial> a mass of 1 kg and an inertia of (1, 1, 1),
       silently apart from a C-level warning. On a small arm that is kilograms of phantom mass at
       the wrist; MuJoCo instead computes it from the geometry at water density.""",
@@ -87,6 +91,7 @@ def inertial_missing(ctx) -> Iterator[Hit]:
 
 
 @rule("I002", "fixed-link-inertial-missing", "warning", "Link on a fixed joint without <inertial>",
+      engines=("pybullet",),
       why="""A frame link (tool tip, sensor frame) hangs from a fixed joint and often has neither
       geometry nor <inertial>. PyBullet still gives it 1 kg and I = 1, so every tcp/camera frame adds
       a kilogram to the arm's end.""",
@@ -110,6 +115,9 @@ def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
 
 
 @rule("I003", "mass-not-positive", "error", "Mass missing, zero or negative on a moving link",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks="PyBullet makes a mass-0 link static and diverges on a negative mass; MuJoCo refuses the file.",
       why="""A moving body needs positive mass. PyBullet treats mass 0 as static (the link stops
       following the physics), negative mass makes the dynamics diverge, and MuJoCo refuses both.""",
       fix="Set the link's real mass in kg.",
@@ -141,6 +149,10 @@ def _tensor_hits(ctx, test):
 
 
 @rule("I004", "inertia-not-positive-definite", "error", "Inertia tensor is not positive definite",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks="MuJoCo refuses the body and Drake substitutes the tensor; PyBullet loaded with "
+             "URDF_USE_INERTIA_FROM_FILE drifts or explodes.",
       why="""Every principal moment of a real body is positive. A zero or negative one makes the
       mass matrix singular or indefinite: PyBullet warns and the simulation drifts or explodes,
       MuJoCo and Drake refuse or substitute the tensor. Tensors that are zero apart from rounding
@@ -156,6 +168,10 @@ def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
 
 
 @rule("I005", "inertia-triangle", "error", "Inertia violates the triangle inequality",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks='MuJoCo refuses the file ("inertia must satisfy A + B >= C"); PyBullet simulates a body that cannot '
+             "exist.",
       why="""For a real body each principal moment is at most the sum of the other two
       (A + B >= C). A tensor that breaks it cannot belong to any mass distribution; MuJoCo refuses
       it ("inertia must satisfy A + B >= C") and PyBullet simulates a body that cannot exist.""",
@@ -172,56 +188,100 @@ def inertia_triangle(ctx) -> Iterator[Hit]:
                   inertial.element.find("inertia"))
 
 
-def _zero_tensor_hits(ctx, on_fixed_links: bool) -> Iterator[Hit]:
-    """I006 and I008: positive mass with a missing, zero or effectively zero tensor."""
-    fixed = _fixed_links(ctx.model)
+def _zero_tensor_hits(ctx, in_inert_body: bool) -> Iterator[Hit]:
+    """I006 (``in_inert_body``) and I008: positive mass with a zero or effectively zero tensor, split by
+    whether the rigid body the link is welded into (fixed joints) has rotational inertia of its own.
+    A missing <inertia> is I006's on a moving link (S019 reports it on the others)."""
+    moving = _moving_links(ctx.model)
     for link in ctx.model.links:
         inertial = link.inertial
         if inertial is None or not (inertial.mass or 0) > 0:
             continue
         element = inertial.element.find("inertia")
         if element is None:
-            if not on_fixed_links:  # urdfdom refuses an <inertial> without <inertia>, fixed or not
+            if in_inert_body and link.name in moving:  # urdfdom refuses it too: on other links that is S019's
                 yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg but no <inertia>", inertial.element)
             continue
-        if (link.name in fixed) != on_fixed_links or not finite_tensor(inertial.tensor):
+        if not finite_tensor(inertial.tensor):
             continue
-        where = f" on fixed joint '{fixed[link.name].name}'" if on_fixed_links else ""
-        if not any(inertial.tensor):
-            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and an all-zero inertia tensor", element)
-        elif effectively_zero(moments := tensor_moments(inertial.tensor)):
-            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and an effectively zero inertia "
-                      f"tensor: principal moments {_fmt(moments)}, all below {EFFECTIVELY_ZERO:g} kg·m²", element)
+        if any(inertial.tensor):
+            moments = tensor_moments(inertial.tensor)
+            if not effectively_zero(moments):
+                continue
+            what = (f"an effectively zero inertia tensor: principal moments {_fmt(moments)}, all below "
+                    f"{EFFECTIVELY_ZERO:g} kg·m²")
+        else:
+            what = "an all-zero inertia tensor"
+        body = ctx.rigid_body(link)
+        inert = _inert(body)
+        if inert is None or inert != in_inert_body:
+            continue  # a body whose numbers are not finite: F007's
+        welded = [name for name in body.members if name != link.name]
+        if in_inert_body:
+            shown = ", ".join(f"'{name}'" for name in welded[:3]) + (", ..." if len(welded) > 3 else "")
+            also = f", nor have the links welded to it ({shown})" if welded else ""
+            yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg and {what}{also}", element)
+        else:
+            joint = ctx.model.parent_joint(link.name)
+            where = f" on fixed joint '{joint.name}'" if joint is not None and joint.type == "fixed" else ""
+            carrier = max(welded, key=lambda name: _mass(ctx.model.link(name)))
+            yield Hit(f"link '{link.name}'{where} has mass {inertial.mass:g} kg and {what}; welded into one body "
+                      f"with '{carrier}', whose inertia carries it", element)
+
+
+def _mass(link) -> float:
+    """The link's mass when it is a positive finite number, else 0."""
+    mass = link.inertial.mass if link is not None and link.inertial is not None else None
+    return mass if mass is not None and math.isfinite(mass) and mass > 0 else 0.0
+
+
+def _inert(body) -> bool | None:
+    """True when a rigid body has no usable rotational inertia (its composite's smallest moment is below
+    mjMINVAL, or below 1e-9 of its largest), None when its numbers are not finite."""
+    if not all(map(math.isfinite, body.moments)):
+        return None
+    smallest, largest = body.moments[0], body.moments[-1]
+    return not smallest >= max(MJ_MINVAL, NEAR_SINGULAR_RATIO * largest)
 
 
 _ZERO_TENSOR = '<inertial><mass value="1"/><inertia ixx="0" ixy="0" ixz="0" iyy="0" iyz="0" izz="0"/></inertial>'
 
 
 @rule("I006", "inertia-zero", "error", "Zero or missing inertia tensor with positive mass on a moving link",
+      engines=("pybullet", "mujoco", "drake", "gazebo"),
+      refused_by=("mujoco",),
+      breaks="MuJoCo refuses the moving body (moments below mjMINVAL) and PyBullet loaded with "
+             "URDF_USE_INERTIA_FROM_FILE divides by the zero moments.",
       why="""A body with mass but no rotational inertia (ixx = iyy = izz = 0, moments below 1e-15 that
       are zero written with rounding noise, or no <inertia>) is a point mass. On a link that moves
       (or on the root, which floats unless fixed by the loader) PyBullet divides by the zero moments
       and the joint accelerations blow up; MuJoCo's URDF import reads an all-zero tensor as
       "not given" and refuses a moving body whose moments are below mjMINVAL. urdfdom refuses an
-      <inertial> without <inertia> outright. Links welded to their parent by a fixed joint are
-      I008's.""",
+      <inertial> without <inertia> outright. Engines simulate links welded by fixed joints as one
+      body (MuJoCo fuses them, PyBullet's articulated solver carries their inertia together), so a
+      zero tensor is reported here only when that whole body has no rotational inertia; a virtual
+      root (mass 1e-10, zero tensor) welded to a body with real inertia is I008's, an info (measured:
+      stable fixed and floating in PyBullet 3.2.7 and MuJoCo 4.0).""",
       fix="Compute the tensor from the geometry (box: m(y²+z²)/12 ...; ar3cli fix-inertia).",
       bad=arm(link_extra=_ZERO_TENSOR),
       good=arm(), fixed_by="fix-inertia",
-      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m² (MuJoCo's mjMINVAL).",
+      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m² (MuJoCo's mjMINVAL); "
+                 "the welded body lacks inertia when its composite tensor's smallest moment is below MJ_MINVAL or "
+                 "NEAR_SINGULAR_RATIO = 1e-9 of its largest.",
       references="MuJoCo user_model.cc (moving bodies need mass and moments >= mjMINVAL) and xml_urdf.cc (an "
                  "all-zero tensor is undefined); urdfdom link.cpp "
                  "parseInertial (\"Inertial element must have inertia element\").")
 def inertia_zero(ctx) -> Iterator[Hit]:
-    yield from _zero_tensor_hits(ctx, on_fixed_links=False)
+    yield from _zero_tensor_hits(ctx, in_inert_body=True)
 
 
-@rule("I008", "inertia-zero-fixed-link", "info", "Zero inertia tensor with positive mass on a link on a fixed joint",
-      why="""A link welded to its parent by a fixed joint never rotates by itself: every engine
-      adds its mass to the parent's body (PyBullet and Drake weld it, MuJoCo can fuse it), where a point
-      mass at an offset is harmless. Still, the zero tensor is not the part's real inertia (sensor
-      frames and tool flanges often carry a placeholder mass), and the link becomes a problem the day
-      the joint is made movable.""",
+@rule("I008", "inertia-zero-fixed-link", "info", "Zero inertia tensor on a link welded to a body that has inertia",
+      why="""A link welded by fixed joints to links with real inertia never rotates by itself: every
+      engine simulates the welded links as one body (PyBullet and Drake weld it, MuJoCo fuses it), whose
+      composite inertia carries the point mass. That covers a sensor frame or flange on a fixed joint,
+      and a virtual root (mass 0 or 1e-10) welded to the real base: measured stable fixed and floating
+      in PyBullet 3.2.7 and MuJoCo 4.0. Still, the zero tensor is not the part's real inertia, and the
+      link becomes a problem the day the joint is made movable. A body with no inertia at all is I006's.""",
       fix="Compute the tensor from the geometry (ar3cli fix-inertia), or drop the mass if the link is a pure frame.",
       bad=robot(f"""
           <link name="base">{LINK_INERTIAL}</link><link name="flange">{_ZERO_TENSOR}</link>
@@ -230,19 +290,25 @@ def inertia_zero(ctx) -> Iterator[Hit]:
           <link name="base">{LINK_INERTIAL}</link><link name="flange">{LINK_INERTIAL}</link>
           <joint name="flange_joint" type="fixed"><parent link="base"/><child link="flange"/></joint>"""),
       fixed_by="fix-inertia",
-      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m².")
+      thresholds="Effectively zero: every principal moment below EFFECTIVELY_ZERO = 1e-15 kg·m². The welded body "
+                 "has inertia when its composite tensor (parallel-axis terms included) has every moment at least "
+                 "MJ_MINVAL and at least NEAR_SINGULAR_RATIO = 1e-9 of its largest.")
 def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
-    yield from _zero_tensor_hits(ctx, on_fixed_links=True)
+    yield from _zero_tensor_hits(ctx, in_inert_body=False)
 
 
 @rule("I009", "inertia-near-singular", "error", "Near-singular inertia tensor on a moving link",
+      engines=("mujoco", "pybullet", "drake"),
+      refused_by=("mujoco",),
+      breaks="MuJoCo refuses the body (a moment below mjMINVAL); every solver that inverts the tensor meets a "
+             "condition number above 1e9.",
       why="""A principal moment below MuJoCo's mjMINVAL (1e-15 kg·m²) makes MuJoCo refuse a moving
       body ("mass and inertia of moving bodies must be larger than mjMINVAL"; (2.2e-18, 0.215,
       0.215) is refused). A moment below 1e-9 of the largest belongs to no real body (a rod's ratio
       is 6(r/L)²): it is a typo or lost digits, and it makes the body's inertia ill-conditioned (condition
-      number above 1e9) where a solver inverts it: a floating base, a ball joint. Links on fixed
-      joints are exempt (their inertia is added to the parent's); tensors that also break A + B >= C
-      are I005's.""",
+      number above 1e9) where a solver inverts it: a floating base, a ball joint. Links welded by fixed
+      joints to links whose inertia carries them are exempt (engines simulate the welded links as one
+      body); tensors that also break A + B >= C are I005's.""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="2.2e-18" ixy="0" ixz="0" iyy="0.215" iyz="0" izz="0.215"/></inertial>'),
       good=arm(link_extra='<inertial><mass value="1"/><inertia ixx="1e-4" ixy="0" ixz="0" iyy="0.215" iyz="0" izz="0.215"/></inertial>'),
@@ -251,14 +317,12 @@ def inertia_zero_fixed_link(ctx) -> Iterator[Hit]:
                  "times the largest, while the largest is at least 1e-15 (else I006/I008).",
       references="MuJoCo include/mujoco/mjtnum.h (mjMINVAL) and src/user/user_model.cc (moving-body check).")
 def inertia_near_singular(ctx) -> Iterator[Hit]:
-    fixed = _fixed_links(ctx.model)
-
     def ok(inertial, moments) -> bool:
         return not near_singular(moments) or not _triangle_ok(inertial, moments)
 
     for link, inertial, moments in _tensor_hits(ctx, ok):
-        if link.name in fixed or not (inertial.mass or 0) > 0:
-            continue
+        if not (inertial.mass or 0) > 0 or _inert(ctx.rigid_body(link)) is not True:
+            continue  # welded to links whose inertia carries it (or numbers that are not finite: F007's)
         smallest, largest = moments[0], moments[-1]
         why = (f"below MuJoCo's mjMINVAL {MJ_MINVAL:g}: MuJoCo refuses the body" if smallest < MJ_MINVAL else
                f"{smallest / largest:.1e} of the largest: no real body is that thin")
@@ -270,35 +334,122 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
       why="""The radius of gyration sqrt(I_max / m) of a body is at most the size of the body (about
       its COM it cannot exceed the diagonal of its bounding box). A much larger value means the
       tensor belongs to something else: a placeholder I = 1 on a 0.1 kg link, grams vs kilograms, or
-      g·mm² vs kg·m². The link then swings like a body many metres wide.""",
+      g·mm² vs kg·m². The link then swings like a body many metres wide. A tensor no body can have
+      (I004, I005, I009) is reported there alone. When the tensor read in kg·mm² or g·mm² (a CAD
+      export's units) gives the robot's typical radius of gyration, the message says so, with the
+      value in kg·m².""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
       bad=arm(link_extra='<inertial><mass value="0.1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'
                          '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'),
       good=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision>'),
       fixed_by="fix-inertia --include-implausible",
       thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the link's "
-                 "geometry box (collision shapes, else visual).")
+                 "geometry box (collision shapes, else visual). A unit is named when the tensor / 1e6 (kg·mm²) or / 1e9 "
+                 "(g·mm²) gives a ratio within SAME_SHAPE = 5x of the robot's median link ratio and an I_max within "
+                 "SOLID_RANGE = 0.05 to 4 times a solid box the size of the geometry; never for a placeholder (a "
+                 "diagonal of powers of ten).")
 def inertia_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        inertial = link.inertial
-        if inertial is None or not finite_tensor(inertial.tensor) or not (inertial.mass or 0) > 0 \
-                or not math.isfinite(inertial.mass):
+        found = _gyration_ratio(ctx, link)
+        if found is None or found[0] <= IMPLAUSIBLE_FACTOR:
             continue
-        bounds = ctx.link_bounds(link)
-        if bounds is None:
-            continue
-        half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
-        moments = tensor_moments(inertial.tensor)
-        if half_diagonal <= 0 or moments[-1] <= 0:
-            continue
-        gyration = math.sqrt(moments[-1] / inertial.mass)
-        if gyration > IMPLAUSIBLE_FACTOR * half_diagonal:
-            yield Hit(f"link '{link.name}' radius of gyration {gyration:.3g} m is {gyration / half_diagonal:.0f}x "
-                      f"its geometry's half-diagonal {half_diagonal:.3g} m (mass {inertial.mass:g} kg, "
-                      f"I_max {moments[-1]:.3g} kg·m²)", inertial.element.find("inertia"))
+        ratio, gyration, half_diagonal, largest = found
+        unit = tensor_unit(ctx, link)
+        looks = (f": the tensor looks like {unit[0]} (I_max {largest / unit[1]:.3g} kg·m²?)" if unit is not None else "")
+        yield Hit(f"link '{link.name}' radius of gyration {gyration:.3g} m is {ratio:.0f}x "
+                  f"its geometry's half-diagonal {half_diagonal:.3g} m (mass {link.inertial.mass:g} kg, "
+                  f"I_max {largest:.3g} kg·m²){looks}", link.inertial.element.find("inertia"),
+                  hint=(f"Divide every inertia entry by {unit[1]:.0e} (kg·m²), or recompute it: ar3cli fix-inertia "
+                        "rescales it." if unit is not None else None))
+
+
+def _gyration_ratio(ctx, link, mass: float | None = None) -> tuple[float, float, float, float] | None:
+    """(radius of gyration / the half-diagonal of the link's geometry box, the radius of gyration
+    sqrt(I_max / m), the half-diagonal, I_max) of a valid tensor, with the file's mass (or ``mass``);
+    None when there is nothing to compare. Once per link, mass and file."""
+    known = ctx.shared("gyration-ratios", lambda _model: {})
+    key = (id(link), mass)
+    if key not in known:
+        known[key] = _gyration(ctx, link, mass)
+    return known[key]
+
+
+def _gyration(ctx, link, mass: float | None) -> tuple[float, float, float, float] | None:
+    inertial = link.inertial
+    mass = mass if mass is not None else (inertial.mass if inertial is not None else None)
+    if inertial is None or not finite_tensor(inertial.tensor) or mass is None or not mass > 0 \
+            or not math.isfinite(mass):
+        return None
+    bounds = ctx.link_bounds(link)
+    if bounds is None:
+        return None
+    half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
+    moments = tensor_moments(inertial.tensor)
+    if half_diagonal <= 0 or moments[-1] <= 0 or not _valid_body(inertial, moments):
+        return None  # a tensor no body has is I004's, I005's or I009's: one cause, one finding
+    gyration = math.sqrt(moments[-1] / mass)
+    return gyration / half_diagonal, gyration, half_diagonal, moments[-1]
+
+
+TENSOR_UNITS = (("kg·mm²", 1e6), ("g·mm²", 1e9))
+"""Units a CAD export writes tensors in, and how many of them make a kg·m² (I007)."""
+SAME_SHAPE = 5.0
+"""A tensor taken in another unit must give a radius of gyration within this factor of the robot's
+typical link (relative to each link's own size) to be said to be in that unit."""
+
+
+SOLID_RANGE = (0.05, 4.0)
+"""... and an I_max within this range of a solid box's the size of the link's geometry (a part fills part of
+its box; a thin shell about its COM reaches a few times the solid box)."""
+
+
+def _placeholder_tensor(tensor) -> bool:
+    """A diagonal tensor of powers of ten (I = 1; pr2's sensor frames' 1e-4, 1e-6, 1e-4): a placeholder
+    someone typed, not a CAD export in another unit."""
+    ixx, ixy, ixz, iyy, iyz, izz = tensor
+    if ixy or ixz or iyz or not min(ixx, iyy, izz) > 0:
+        return False
+    return all(abs(math.log10(value) - round(math.log10(value))) < 1e-9 for value in (ixx, iyy, izz))
+
+
+def typical_gyration(ctx) -> float:
+    """The median, over the robot's links with a plausible tensor, of radius of gyration / half-diagonal
+    (how its parts fill their boxes); 0.5 (a solid part) when no link has one."""
+    def build(_model) -> float:
+        ratios = sorted(found[0] for link in ctx.model.links
+                        if (found := _gyration_ratio(ctx, link)) is not None and found[0] <= IMPLAUSIBLE_FACTOR)
+        return ratios[len(ratios) // 2] if ratios else 0.5
+    return ctx.shared("typical-gyration", build)
+
+
+def tensor_unit(ctx, link) -> tuple[str, float] | None:
+    """(unit, kg·m² divisor) when the link's tensor looks written in kg·mm² or g·mm² (x1e6, x1e9): taken in
+    that unit, its radius of gyration, with the link's mass in kg (read as grams when I013 says so), is
+    plausible and within SAME_SHAPE of the robot's typical link, and its I_max within SOLID_RANGE of a solid
+    box the size of the link's geometry; the closest such unit. A placeholder (I = 1) is no unit. None
+    otherwise."""
+    mass = grams_evidence(ctx, link)
+    found = _gyration_ratio(ctx, link, mass)
+    if found is None or found[0] <= IMPLAUSIBLE_FACTOR or _placeholder_tensor(link.inertial.tensor):
+        return None
+    mass = mass or link.inertial.mass
+    box = ctx.link_bounds(link)
+    extents = sorted(hi - lo for lo, hi in zip(*box))
+    solid = mass * (extents[1] ** 2 + extents[2] ** 2) / 12  # I_max of a solid box the size of the geometry
+    typical = typical_gyration(ctx)
+    best = None
+    for unit, divisor in TENSOR_UNITS:
+        converted = found[0] / math.sqrt(divisor)
+        if converted <= IMPLAUSIBLE_FACTOR and typical / SAME_SHAPE <= converted <= typical * SAME_SHAPE \
+                and SOLID_RANGE[0] * solid <= found[3] / divisor <= SOLID_RANGE[1] * solid:
+            miss = abs(math.log(converted / typical))
+            if best is None or miss < best[0]:
+                best = (miss, unit, divisor)
+    return None if best is None else (best[1], best[2])
 
 
 @rule("I010", "mass-zero-with-inertia", "info", "Mass 0 with a non-zero inertia tensor",
+      engines=("drake",),
       why="""mass 0 with a non-zero tensor contradicts itself. PyBullet reads it as the author
       meant: a mass-0 root is static (its idiom for tables and planes) and a mass-0 link on a fixed
       joint adds nothing; MuJoCo's URDF import fixes the root to the world and merges fixed links,
@@ -328,6 +479,7 @@ def mass_zero_with_inertia(ctx) -> Iterator[Hit]:
 
 
 @rule("I011", "world-inertial", "warning", "<inertial> on the link named 'world'",
+      engines=("drake", "ros", "pybullet"),
       why="""A link named "world" is the world itself in Drake, MuJoCo and Gazebo, not a body:
       Drake ignores its <inertial> with a warning, KDL (robot_state_publisher, MoveIt) cannot give
       the root link an inertia and ignores it too. PyBullet alone uses it: with useFixedBase=False the
@@ -352,6 +504,7 @@ def _looks_like_frame(link) -> bool:
 
 
 @rule("I012", "root-inertial-missing", "info", "Root link with geometry but no <inertial>",
+      engines=("pybullet", "drake"),
       why="""This matters only if the robot floats (a mobile base, a legged robot, an object to
       grasp); most arms are loaded with a fixed base and can ignore it. Loaded with
       useFixedBase=False, PyBullet gives a root without <inertial> 1 kg and I = (1, 1, 1), silently
@@ -383,5 +536,33 @@ FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_
          inertia_triangle, inertia_zero, inertia_zero_fixed_link, inertia_near_singular, inertia_implausible)
 """The rules whose links fix-inertia recomputes (:func:`ar3cli.fix.inertia_plan.links_needing_inertia`),
 in its order of reasons: I007 last, so a link reported as I007 has nothing invalid."""
+RESCALED_BY_FIX_INERTIA = (density_implausible,)
+"""Rules fix-inertia answers by rescaling the file's own numbers where their unit is plain (a mass in grams,
+I013; I007's tensors in kg·mm² or g·mm² too): :func:`unit_mistakes`."""
 NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
 """Inertia findings fix-inertia leaves alone: the fix is a decision only the author can make."""
+
+
+def unit_mistakes(ctx) -> dict[str, tuple[float, float, str]]:
+    """Link name -> (mass divisor, tensor divisor, why) for the links whose mass (I013) or tensor (I007) the
+    rules say is in another unit: a mass in grams (/ 1000; its tensor with it when, read with the gram
+    mass, the tensor is a plausible body's) and a tensor in kg·mm² or g·mm². fix-inertia rescales them."""
+    found: dict[str, tuple[float, float, str]] = {}
+    for link in ctx.model.links:
+        grams = grams_evidence(ctx, link)
+        unit = tensor_unit(ctx, link)
+        if grams is None and unit is None:
+            continue
+        reasons, mass_divisor, tensor_divisor = [], 1.0, 1.0
+        if grams is not None:
+            mass_divisor = link.inertial.mass / grams
+            reasons.append(f"I013: mass {link.inertial.mass:g} in grams, / 1000")
+            plain = _gyration_ratio(ctx, link)
+            if unit is None and plain is not None and plain[0] <= IMPLAUSIBLE_FACTOR:
+                tensor_divisor = mass_divisor  # the tensor was written for the gram mass: in g·m²
+                reasons.append("tensor in g·m² with it, / 1000")
+        if unit is not None:
+            tensor_divisor = unit[1]
+            reasons.append(f"I007: tensor in {unit[0]}, / {unit[1]:.0e}")
+        found[link.name] = (mass_divisor, tensor_divisor, "; ".join(reasons))
+    return found

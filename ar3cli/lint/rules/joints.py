@@ -30,6 +30,8 @@ WHEEL_LIKE = ("wheel", "caster", "castor", "roller", "rotor", "propeller", "prop
 
 
 @rule("J001", "limit-missing", "error", "Revolute or prismatic joint without <limit>",
+      refused_by=("pybullet", "ros"),
+      breaks='PyBullet and urdfdom refuse the file ("Joint is of type REVOLUTE but it does not specify limits").',
       why="""The URDF spec requires <limit> on revolute and prismatic joints. PyBullet refuses the
       whole file ("Joint is of type REVOLUTE but it does not specify limits"), urdfdom too.""",
       fix='Add <limit lower="..." upper="..." effort="..." velocity="..."/> (radians, metres, N·m or N, rad/s or m/s).',
@@ -41,6 +43,8 @@ def limit_missing(ctx) -> Iterator[Hit]:
 
 
 @rule("J002", "limit-range-missing", "error", "<limit> without lower/upper on a revolute or prismatic joint",
+      engines=("ros", "pybullet"),
+      breaks="ROS tools lock the joint at 0 while PyBullet leaves it unlimited: one file, two different robots.",
       why="""Without lower/upper, urdfdom and ROS default both to 0 (the joint cannot move), while
       PyBullet reads (0, -1), i.e. unlimited: the same file means a locked joint in one tool and a
       free one in the other.""",
@@ -57,6 +61,7 @@ def limit_range_missing(ctx) -> Iterator[Hit]:
 
 
 @rule("J003", "limit-inverted", "error", "Joint lower limit greater than upper",
+      breaks="PyBullet treats the joint as unlimited and MuJoCo disables the limit: the stops are gone.",
       why="""With lower > upper, PyBullet treats the joint as unlimited and MuJoCo disables the
       limit; samplers drawing uniform(lower, upper) fail or sample nonsense. PyBullet's deliberate
       "no limit" idiom (lower="1" upper="-1" as in pybullet_data, or lower="0" upper="-1") is not
@@ -91,10 +96,21 @@ def _pybullet_unlimited_idiom(joint) -> bool:
       bad=arm(joint_extra='<limit lower="0" upper="0" effort="10" velocity="1"/>'), good=arm())
 def limit_empty(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
-        limit = joint.limit
-        if joint.type in LIMITED_TYPES and limit and limit.lower is not None and limit.lower == limit.upper \
-                and limit.element.get("lower") is not None and limit.element.get("upper") is not None:
-            yield Hit(f"joint '{joint.name}' has lower == upper == {limit.lower:g}: it cannot move", limit.element)
+        if _cannot_move(joint):
+            limit = joint.limit
+            zeros = [f"{key}={value:g}" for key, value in (("effort", limit.effort), ("velocity", limit.velocity))
+                     if value is not None and value <= 0]
+            also = f" (and {' and '.join(zeros)})" if zeros and joint.mimic is None else ""
+            yield Hit(f"joint '{joint.name}' has lower == upper == {limit.lower:g}{also}: it cannot move",
+                      limit.element)
+
+
+def _cannot_move(joint) -> bool:
+    """A revolute or prismatic joint whose lower and upper limits are written and equal (J004)."""
+    limit = joint.limit
+    return joint.type in LIMITED_TYPES and limit is not None and limit.lower is not None \
+        and limit.lower == limit.upper and limit.element.get("lower") is not None \
+        and limit.element.get("upper") is not None
 
 
 def _looks_like_degrees(value: float) -> bool:
@@ -189,6 +205,7 @@ def virtual_base_evidence(model, joint) -> str | None:
 
 
 @rule("J006", "continuous-with-range", "warning", "Continuous joint with lower/upper",
+      engines=("pybullet",),
       why="""The URDF spec ignores lower/upper on continuous joints, and PyBullet never makes them
       a physical stop, but it does clamp POSITION_CONTROL targets to [lower, upper]. The popular
       lower="-100" upper="100" "fix" adds a clamp and fixes nothing; a real arm with hard stops
@@ -208,6 +225,9 @@ def continuous_with_range(ctx) -> Iterator[Hit]:
 
 
 @rule("J007", "effort-velocity-missing", "error", "<limit> without effort or velocity",
+      engines=("ros", "pybullet"),
+      refused_by=("ros",),
+      breaks="urdfdom refuses the file; PyBullet reads 0 for the missing value.",
       why="""effort and velocity are required attributes of <limit>: urdfdom refuses the file, and
       PyBullet reads 0 (no force, no speed for controllers that use them).""",
       fix="Add effort (N·m or N) and velocity (rad/s or m/s) from the actuator's datasheet.",
@@ -225,13 +245,15 @@ def effort_velocity_missing(ctx) -> Iterator[Hit]:
 @rule("J008", "effort-velocity-zero", "warning", "Effort or velocity <= 0 on a moving joint",
       why="""effort and velocity are the actuator's limits. Zero means the joint can exert no force or
       cannot move: ros_control and MoveIt respect that, and controllers that take PyBullet's
-      maxForce from the URDF cannot hold the arm against gravity.""",
+      maxForce from the URDF cannot hold the arm against gravity. A <mimic> follower has no actuator
+      of its own (its leader drives it), so its zeros are not reported; nor are those of a joint whose
+      range is a single point (J004 says it cannot move, and lists them).""",
       fix="Use the real actuator limits from the datasheet.",
       bad=arm(joint_extra='<limit lower="-1" upper="1" effort="0" velocity="0"/>'), good=arm())
 def effort_velocity_zero(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
-        if joint.limit is None or joint.type not in ACTUATED_TYPES:
-            continue
+        if joint.limit is None or joint.type not in ACTUATED_TYPES or joint.mimic is not None or _cannot_move(joint):
+            continue  # a mimic follower has no actuator; a joint that cannot move is J004's
         bad = [f"{key}={value:g}" for key, value in (("effort", joint.limit.effort), ("velocity", joint.limit.velocity))
                if value is not None and value <= 0]
         if bad:
@@ -239,6 +261,8 @@ def effort_velocity_zero(ctx) -> Iterator[Hit]:
 
 
 @rule("J009", "axis-zero", "error", "Zero joint axis",
+      refused_by=("ros", "mujoco"),
+      breaks="PyBullet loads the file and every joint state is NaN after one step; urdfdom and MuJoCo refuse the file.",
       why="""A moving joint needs a direction. With axis 0 0 0 PyBullet loads the file and every
       joint state becomes NaN on the first step; urdfdom and MuJoCo refuse it.""",
       fix='Set the axis to a unit vector, e.g. <axis xyz="0 0 1"/>.',
@@ -381,6 +405,10 @@ def _mimic_robot(follower_type: str, leader_type: str) -> str:
 
 
 @rule("J012", "mimic-not-single-dof", "error", "<mimic> on, or of, a joint that is not revolute, continuous or prismatic",
+      engines=("drake", "ros"),
+      refused_by=("drake",),
+      breaks="Drake refuses the file (a 0-DOF joint cannot mimic a 1-DOF one); MoveIt and joint_state_publisher "
+             "compute the follower from a leader that never moves.",
       why="""A mimic couples one joint position to another: both joints must have exactly one degree
       of freedom. Drake refuses a file where a fixed joint mimics a moving one or a moving joint
       mimics a fixed one ("Joint 'a' which has 0 DOF cannot mimic joint 'b' which has 1 DOF"), and
@@ -434,6 +462,7 @@ def joint_type_portability(ctx) -> Iterator[Hit]:
 
 
 @rule("J014", "pybullet-unlimited-idiom", "info", "lower > upper written as PyBullet's \"no limit\"",
+      engines=("ros",),
       why="""pybullet_data writes lower="1" upper="-1" on purpose (cube_no_rotation.urdf,
       biped2d_pybullet.urdf): PyBullet reads any lower > upper as unlimited, and (0, -1) is what
       getJointInfo reports for an unlimited joint. It is not an inverted range to swap (J003): a

@@ -8,12 +8,13 @@ messages name a link or joint ("Element name 'arm'"): the finding points at its 
 
 from __future__ import annotations
 
-import math
+import contextlib
 from collections.abc import Iterator
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
+from ar3cli.lint.rules.pybullet_sim import unstable_hit
 
 SETTLE_SECONDS = 1.0
 MAX_SETTLE_SPEED = 100.0
@@ -37,10 +38,12 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
 
 
 @rule("M001", "mujoco-compile-failed", "error", "MuJoCo refuses to compile the model",
+      engines=("mujoco",), refused_by=("mujoco",), breaks="MuJoCo refuses the file (measured: ar3cli compiles it).",
       why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
       PyBullet's loader: a moving body whose mass or inertia is below mjMINVAL (a link without <inertial>
       and without collision geometry), an inertia breaking A + B >= C, a zero joint axis. ar3cli quotes
-      MuJoCo's reason at the link or joint it names.""",
+      MuJoCo's reason at the link or joint it names; when a static error that MuJoCo refuses (I005,
+      I006, J009, ...) already names the cause at its line, M001 adds nothing.""",
       fix="Fix the reason quoted in the message (often an I or J finding of the same element).",
       bad=arm(link_extra=""), good=arm(), needs_sim=True,
       references="MuJoCo 4.0 user_objects.cc: 'mass and inertia of moving bodies must be larger than mjMINVAL'")
@@ -48,7 +51,7 @@ def mujoco_compile_failed(ctx) -> Iterator[Hit]:
     from ar3cli.sim.mujoco_session import MujocoCompileError
 
     robot, error = _compiled(ctx)
-    if error is not None:
+    if error is not None and refusal_explained(ctx, "mujoco") is None:  # else a static error says why
         if isinstance(error, MujocoCompileError):
             yield Hit(f"MuJoCo cannot compile it: {error.reason}",
                       error.element if error.element is not None else ctx.model.root)
@@ -63,6 +66,7 @@ _STL = robot(f"""
 
 
 @rule("M002", "mujoco-mesh-unreadable", "warning", "A collision mesh MuJoCo cannot read",
+      engines=("mujoco",),
       why="""MuJoCo reads STL, OBJ and MSH meshes only: a COLLADA (.dae) collision mesh, or one that is not found,
       stops its whole compile with "Error opening file". ar3cli replaces the mesh by its bounding box (or leaves
       it out when its size is unknown) so the other checks still run, and says so here.""",
@@ -78,6 +82,7 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
 
 
 @rule("M003", "mujoco-self-collision-home", "warning", "Links collide in MuJoCo at the home pose",
+      engines=("mujoco",),
       why="""MuJoCo collides every pair of bodies but a parent and its child (no URDF_USE_SELF_COLLISION flag
       to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
       starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
@@ -118,6 +123,7 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
 
 
 @rule("M004", "mujoco-unstable", "error", "NaN or exploding states in MuJoCo after 1 s under gravity",
+      engines=("mujoco",), breaks="MuJoCo's joint states become NaN or explode within one simulated second (measured).",
       why="""ar3cli compiles the model (root welded to the world), puts it at the home pose and simulates one
       second under gravity with MuJoCo's default timestep (2 ms). A real robot falls limp; NaN positions,
       MuJoCo's own instability warning (mjWARN_BADQACC) or joint speeds above 100 rad/s mean an inertia too
@@ -130,7 +136,9 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
               joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><dynamics damping="-50"/>'
               ).replace('<axis xyz="0 0 1"/>', '<axis xyz="0 1 0"/>'),
       good=arm(), needs_sim=True,
-      thresholds="NaN, mjWARN_BADQACC, or a joint faster than MAX_SETTLE_SPEED = 100 rad/s or m/s after SETTLE_SECONDS = 1 s.")
+      thresholds="NaN, mjWARN_BADQACC, or a joint faster than MAX_SETTLE_SPEED = 100 rad/s or m/s after SETTLE_SECONDS = 1 s; "
+                 "one finding per file, at the first such joint, naming the others (one instability drags every "
+                 "joint below it along).")
 def mujoco_unstable(ctx) -> Iterator[Hit]:
     from ar3cli.sim.mujoco_session import home_pose
 
@@ -138,19 +146,38 @@ def mujoco_unstable(ctx) -> Iterator[Hit]:
     if robot is None or not robot.joint_ids:
         return
     robot.set_positions(home_pose(ctx.model))
-    robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
-    bad_acceleration = int(robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)].number)
-    reported = False
+    with _warnings_kept(robot):
+        robot.step(round(SETTLE_SECONDS / robot.m.opt.timestep))
+    warning = robot.d.warning[int(robot.mujoco.mjtWarning.mjWARN_BADQACC)]
+    bad_acceleration = int(warning.number)
+    blamed = _blamed_joint(robot, int(warning.lastinfo)) if bad_acceleration else None
+    states = []
     for name, (position, velocity) in zip(robot.joint_ids, robot.joint_states(list(robot.joint_ids))):
         joint = ctx.model.joint(name)
-        element = joint.element if joint is not None else None
-        if not (math.isfinite(position) and math.isfinite(velocity)):
-            reported = True
-            yield Hit(f"joint '{name}' state is NaN/inf after {SETTLE_SECONDS:g} s under gravity in MuJoCo", element)
-        elif abs(velocity) > MAX_SETTLE_SPEED:
-            reported = True
-            yield Hit(f"joint '{name}' moves at {velocity:.3g} after {SETTLE_SECONDS:g} s under gravity in MuJoCo",
-                      element)
-    if bad_acceleration and not reported:
+        states.append((name, joint.element if joint is not None else None, position, velocity))
+    found = unstable_hit(states, f"after {SETTLE_SECONDS:g} s under gravity in MuJoCo", MAX_SETTLE_SPEED, blamed)
+    if found is not None:
+        yield found
+    elif bad_acceleration:
         yield Hit(f"MuJoCo reported {bad_acceleration} unstable step(s) (bad acceleration; the simulation was reset)",
                   ctx.model.root)
+
+
+@contextlib.contextmanager
+def _warnings_kept(robot):
+    """MuJoCo's warnings while the robot is simulated go to ``robot.warnings``: its default handler prints
+    them and appends them to MUJOCO_LOG.TXT in the current directory, a file nobody asked for."""
+    previous = robot.mujoco.get_mju_user_warning()
+    robot.mujoco.set_mju_user_warning(lambda text: robot.warnings.append(str(text).strip()))
+    try:
+        yield
+    finally:
+        robot.mujoco.set_mju_user_warning(previous)
+
+
+def _blamed_joint(robot, dof: int) -> str | None:
+    """The joint of the degree of freedom MuJoCo's bad-acceleration warning names (its ``lastinfo``)."""
+    try:
+        return robot.m.joint(int(robot.m.dof_jntid[dof])).name or None
+    except (IndexError, KeyError, ValueError):
+        return None

@@ -55,6 +55,28 @@ def rigid_masses(model) -> dict[str, float]:
     return {link.name: totals[find(link.name)] for link in model.links}
 
 
+def subtree_masses(model) -> dict[str, float]:
+    """Link name -> the mass of the link and everything below it (what its parent joint moves): the
+    joint-space inertia a joint sees is that of its whole subtree, so a light link between two joints
+    of a finger is carried by the finger below it. Masses as in :func:`rigid_masses`. Linear: links in
+    breadth-first order from the roots, then each one's total added to its parent's, deepest first (a
+    link reached twice, or in a loop no root reaches, counts its own mass only: S006's business)."""
+    totals = {link.name: (mass if (mass := link.inertial.mass if link.inertial is not None else None) is not None
+                          and math.isfinite(mass) and mass > 0 else 0.0) for link in model.links}
+    order = [link.name for link in model.root_links()]
+    seen = set(order)
+    for name in order:  # grows while it is walked: breadth-first
+        for joint in model.child_joints(name):
+            if joint.child in totals and joint.child not in seen:
+                seen.add(joint.child)
+                order.append(joint.child)
+    for name in reversed(order):
+        joint = model.parent_joint(name)
+        if joint is not None and joint.parent in seen and joint.parent != name:
+            totals[joint.parent] += totals[name]
+    return totals
+
+
 def _primitive_volume(shape) -> float | None:
     """Exact volume of a box, cylinder, sphere or capsule (m³), None for meshes and unknown shapes."""
     kind, params = shape.geometry.kind, shape.geometry.params
@@ -81,7 +103,15 @@ def _box_volume(ctx, shape) -> float | None:
 
 def density_bounds(ctx, link) -> tuple[float | None, float | None]:
     """(highest possible density, lowest possible density) in kg/m³ from the link's collision shapes;
-    each None when the shapes cannot bound it."""
+    each None when the shapes cannot bound it. Once per link and file (I013, its grams evidence and the
+    robot's typical density all ask)."""
+    known = ctx.shared("density-bounds", lambda _model: {})
+    if id(link) not in known:  # the model, and with it every link, lives as long as the context
+        known[id(link)] = _density_bounds(ctx, link)
+    return known[id(link)]
+
+
+def _density_bounds(ctx, link) -> tuple[float | None, float | None]:
     mass = link.inertial.mass if link.inertial is not None else None
     if mass is None or not mass >= DENSITY_MIN_MASS or not math.isfinite(mass) or not link.collisions:
         return None, None
@@ -98,6 +128,44 @@ def density_bounds(ctx, link) -> tuple[float | None, float | None]:
     return highest, lowest
 
 
+GRAMS = 1000.0
+"""Grams per kilogram: a mass typed in grams is this many times too large."""
+SAME_MATERIAL = 10.0
+"""A link whose mass, taken as grams, gives a density within this factor of the robot's typical link is
+made of what the rest is made of: the mass was typed in grams (I013). The factor spans plastic to steel
+(1,200 to 7,850 kg/m³) and, roughly, how much of its box a part fills."""
+
+
+def typical_density(ctx) -> float | None:
+    """The robot's typical link density (kg/m³): the median of the lowest possible densities
+    (:func:`density_bounds`) of its links that some material has; None when no link has one (a robot
+    written in grams throughout)."""
+    def build(_model) -> float | None:
+        lows = sorted(low for link in ctx.model.links
+                      if (low := density_bounds(ctx, link)[1]) is not None and low <= MAX_DENSITY)
+        return lows[len(lows) // 2] if lows else None
+    return ctx.shared("typical-density", build)
+
+
+def grams_evidence(ctx, link) -> float | None:
+    """The link's mass in kg when it was typed in grams: divided by 1000, its lowest possible density is a
+    material's and within SAME_MATERIAL of the robot's typical link (:func:`typical_density`; a robot with no
+    plausible link is judged on materials alone, and then only a density no material has says grams), and
+    the part still weighs a gram at least (a 0.1 kg tool frame in a 1 cm box is a lumped placeholder, not
+    0.1 g). None otherwise. A bicycle frame's box is mostly air: 1 kg in it is 0.3 kg/m³, and typed in grams
+    it is still a material's density; only the robot's other links show it is 1000 times theirs."""
+    highest, lowest = density_bounds(ctx, link)
+    if lowest is None or not link.inertial.mass / GRAMS >= MIN_MASS:
+        return None
+    low, high = lowest / GRAMS, (highest / GRAMS if highest is not None else None)
+    if low > MAX_DENSITY or (high is not None and high < MIN_DENSITY):
+        return None
+    typical = typical_density(ctx)
+    if typical is None:  # nothing to compare with: only a density no material has says grams
+        return link.inertial.mass / GRAMS if lowest > MAX_DENSITY else None
+    return link.inertial.mass / GRAMS if typical / SAME_MATERIAL <= low <= typical * SAME_MATERIAL else None
+
+
 def _dense(mass: str, size: str = "0.1 0.1 0.1") -> str:
     return robot(f"""
         <link name="base"><inertial><mass value="{mass}"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
@@ -108,7 +176,9 @@ def _dense(mass: str, size: str = "0.1 0.1 0.1") -> str:
       why="""Mass over the volume of the link's collision geometry is a density; outside what materials
       allow, the mass or the geometry is wrong: a mass in grams or a size in millimetres, a hollow cover
       modelled as a solid box, a copied <mass>. Contact and gravity forces then disagree with the shape
-      the simulator collides with.""",
+      the simulator collides with. A link whose mass, read as grams, gives the density of the
+      robot's other links (it is about 1000 times theirs, whether or not a material could be that
+      dense) is said to be in grams, with the value in kilograms.""",
       fix="Check the <mass value> (kg) and the collision sizes (m); compute the mass from the real part's density.",
       bad=_dense("1", "0.5 0.5 0.5"), good=_dense("2.7"),
       thresholds=f"Reported below {MIN_DENSITY:g} kg/m³ (on the largest collision primitive alone, so overlapping "
@@ -116,17 +186,30 @@ def _dense(mass: str, size: str = "0.1 0.1 0.1") -> str:
                  f"without reading their triangles) or above {MAX_DENSITY:,.0f} kg/m³ (osmium is 22,590; judged on the "
                  "sum of the collision (or, when larger, the visual) shapes' boxes, an upper bound on any volume, meshes "
                  f"included). Links under {DENSITY_MIN_MASS:g} kg and primitives under {DENSITY_MIN_SIZE} m across are "
-                 "placeholders and contact points, not judged.",
+                 f"placeholders and contact points, not judged. Grams: the mass / 1000 gives a density within "
+                 f"materials and within SAME_MATERIAL = {SAME_MATERIAL:g}x of the robot's median link.",
+      fixed_by="fix-inertia (a mass in grams)",
       references="CRC Handbook of Chemistry and Physics (osmium 22.59 g/cm³); simcheck 0.2.0 (density).")
 def density_implausible(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
         highest, lowest = density_bounds(ctx, link)
-        if highest is not None and highest < MIN_DENSITY:
+        if lowest is not None and lowest <= MAX_DENSITY and (grams := grams_evidence(ctx, link)) is not None:
+            yield Hit(f"link '{link.name}' is at least {lowest:.4g} kg/m³ ({link.inertial.mass:g} kg in its collision "
+                      f"shapes), about 1000 times the robot's other links ({typical_density(ctx):.3g} kg/m³): the mass "
+                      f"looks like grams ({grams:.6g} kg?)", _mass_element(link),
+                      hint=f'Write <mass value="{grams:.6g}"/> (kilograms), and check the tensor\'s unit; ar3cli '
+                           "fix-inertia rescales it.")
+        elif highest is not None and highest < MIN_DENSITY:
             yield Hit(f"link '{link.name}' is at most {highest:.3g} kg/m³ ({link.inertial.mass:g} kg in its collision "
                       f"shapes): lighter than any solid material", _mass_element(link))
         elif lowest is not None and lowest > MAX_DENSITY:
+            grams = grams_evidence(ctx, link)
+            unit = (f"; the mass looks like grams ({grams:.6g} kg?, at least {lowest / GRAMS:.4g} kg/m³ then, like the "
+                    "robot's other links)" if grams is not None else "")
             yield Hit(f"link '{link.name}' is at least {lowest:.4g} kg/m³ ({link.inertial.mass:g} kg in its collision "
-                      f"shapes): denser than any material", _mass_element(link))
+                      f"shapes): denser than any material{unit}", _mass_element(link),
+                      hint=f'Write <mass value="{grams:.6g}"/> (kilograms), and check the tensor\'s unit; ar3cli '
+                           "fix-inertia rescales it." if grams is not None else None)
 
 
 def _mass_element(link):
@@ -138,21 +221,23 @@ def _mass_element(link):
       why="""A moving link of less than a gram next to kilogram links makes the joint-space inertia
       matrix ill-conditioned: PyBullet and MuJoCo then need tiny time steps, and the joint
       accelerations of that link jitter or blow up. Real moving parts weigh grams at least; a link
-      this light is usually a frame that should hang from a fixed joint, or a mass in the wrong unit.""",
+      this light is usually a frame that should hang from a fixed joint, or a mass in the wrong unit.
+      What a joint moves is its whole subtree: a light link between two joints (the cross of a
+      universal joint in a finger) is carried by the links below it and is not reported.""",
       fix="Give the link its real mass, or attach a frame-only link with a fixed joint.",
       bad=arm(link_extra='<inertial><mass value="0.00001"/><inertia ixx="1e-9" ixy="0" ixz="0" iyy="1e-9" iyz="0" izz="1e-9"/></inertial>'),
       good=arm(),
-      thresholds=f"Moving links (revolute, continuous, prismatic, planar, floating, spherical) whose rigid group (the link "
-                 f"and the links fixed joints weld to it) weighs more than 0 and less than {MIN_MASS:g} kg.",
+      thresholds=f"Moving links (revolute, continuous, prismatic, planar, floating, spherical) whose subtree (the link "
+                 f"and every link below it) weighs more than 0 and less than {MIN_MASS:g} kg.",
       references="MuJoCo documentation, Computation (ill-conditioned mass matrices need smaller timesteps).")
 def mass_tiny(ctx) -> Iterator[Hit]:
     moving = {joint.child: joint for joint in ctx.model.joints if joint.moves and joint.child}
-    group = rigid_masses(ctx.model)
+    carried = subtree_masses(ctx.model)
     for link in ctx.model.links:
         mass = link.inertial.mass if link.inertial is not None else None
-        if link.name in moving and mass is not None and mass > 0 and 0 < group[link.name] < MIN_MASS:
-            yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') and weighs {group[link.name]:g} kg "
-                      "with the links welded to it", link.inertial.element.find("mass"))
+        if link.name in moving and mass is not None and mass > 0 and 0 < carried[link.name] < MIN_MASS:
+            yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') and weighs {carried[link.name]:g} kg "
+                      "with everything below it", link.inertial.element.find("mass"))
 
 
 @rule("I015", "mass-ratio", "warning", "Masses across a joint differ more than solvers handle",

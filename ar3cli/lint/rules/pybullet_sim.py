@@ -12,7 +12,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 
 from ar3cli.errors import UserError
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
 
 INERTIA_TOLERANCE = 0.10
 """Relative difference between the file and PyBullet's value above which P003 reports a link."""
@@ -48,16 +48,20 @@ def _home(body) -> dict[str, float] | None:
 
 
 @rule("P001", "sim-load-failed", "error", "PyBullet cannot load the model",
+      engines=("pybullet",), refused_by=("pybullet",), breaks="PyBullet refuses the file (measured: ar3cli loads it).",
       why="""What matters in the end is whether the simulator accepts the file. PyBullet's own error is
       "Cannot load URDF file."; ar3cli captures its C output and reports the real reason (a missing
-      mesh, a joint without limits, ...).""",
+      mesh, a joint without limits, ...). When a static error that PyBullet refuses (G001, J001, G004,
+      ...) already names the cause at its line, P001 adds nothing.""",
       fix="Fix the reason quoted in the message (often a G001 or J001 finding).",
-      bad=arm(joint_extra=""), good=arm(), needs_sim=True)
+      bad=arm(link_extra=LINK_INERTIAL + '<collision><geometry><cylinder radius="0.05"/></geometry></collision>'),
+      good=arm(), needs_sim=True)
 def sim_load_failed(ctx) -> Iterator[Hit]:
     try:
         body = ctx.session.load(ctx.model, allow_nan_frames=True)
     except UserError as exc:
-        yield Hit(exc.message.removeprefix(f"{ctx.model.path}: "), ctx.model.root)
+        if refusal_explained(ctx, "pybullet") is None:  # a static error already says why, at its line
+            yield Hit(exc.message.removeprefix(f"{ctx.model.path}: "), ctx.model.root)
         return
     body.remove()
 
@@ -75,6 +79,7 @@ def _stacked_boxes(tip_z: float) -> str:
 
 
 @rule("P002", "sim-self-collision-home", "warning", "Links collide at the home pose",
+      engines=("pybullet",),
       why="""Two links that are not adjacent but interpenetrate (deeper than 1 µm) at the home pose
       (all joints at 0, or mid-range where 0 is outside the limits; mimic joints following) mean
       overlapping collision meshes or a wrong joint origin. With self-collision on, PyBullet pushes
@@ -113,6 +118,7 @@ def _depth_text(depth: float) -> str:
 
 
 @rule("P003", "sim-inertia-differs", "info", "PyBullet uses a different mass or inertia than the file",
+      engines=("pybullet",),
       why="""By default (no URDF_USE_INERTIA_FROM_FILE flag) PyBullet keeps the file's mass but
       recomputes every inertia tensor from the collision shape's bounding box, padded by the
       collision margin. Code that loads with default flags simulates these values, not the file's.""",
@@ -167,6 +173,8 @@ def _differs(used: float, declared: float) -> bool:
 
 
 @rule("P004", "sim-unstable", "error", "NaN or exploding states after settling under gravity",
+      engines=("pybullet",),
+      breaks="PyBullet's joint states become NaN or explode within one simulated second (measured).",
       why="""ar3cli loads the model (fixed base, inertia from the file), puts it at the home pose,
       turns off PyBullet's default joint motors and simulates one second under gravity. A real
       robot falls limp; NaN positions or joint speeds above 100 rad/s mean an unphysical inertia,
@@ -175,7 +183,8 @@ def _differs(used: float, declared: float) -> bool:
       bad=arm(link_extra='<inertial><mass value="1"/><inertia ixx="1e-9" ixy="0" ixz="0" iyy="1e-9" iyz="0" izz="1e-9"/>'
                          '</inertial>').replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 0"/>'),
       good=arm(), needs_sim=True,
-      thresholds='A joint NaN/inf, or faster than MAX_SETTLE_SPEED = 100 rad/s or m/s, after SETTLE_STEPS = 240 steps (1 s) under gravity.')
+      thresholds="A joint NaN/inf, or faster than MAX_SETTLE_SPEED = 100 rad/s or m/s, after SETTLE_STEPS = 240 steps (1 s) "
+                 "under gravity; one finding per file, at the first such joint, naming the others.")
 def sim_unstable(ctx) -> Iterator[Hit]:
     with _loaded(ctx) as body:
         home = _home(body) if body is not None and body.actuated_joints else None
@@ -184,13 +193,40 @@ def sim_unstable(ctx) -> Iterator[Hit]:
         body.set_positions(home)
         body.release_motors()
         ctx.session.step(SETTLE_STEPS)  # the lint session has gravity (lint.Context.session)
-        for joint, (position, velocity) in zip(body.actuated_joints, body.joint_states()):
-            if not (math.isfinite(position) and math.isfinite(velocity)):
-                yield Hit(f"joint '{joint.name}' state is NaN/inf after {SETTLE_STEPS} steps under gravity",
-                          joint.urdf.element if joint.urdf else None)
-            elif abs(velocity) > MAX_SETTLE_SPEED:
-                yield Hit(f"joint '{joint.name}' moves at {velocity:.3g} after {SETTLE_STEPS} steps under gravity",
-                          joint.urdf.element if joint.urdf else None)
+        states = [(joint.name, joint.urdf.element if joint.urdf else None, position, velocity)
+                  for joint, (position, velocity) in zip(body.actuated_joints, body.joint_states())]
+        found = unstable_hit(states, f"after {SETTLE_STEPS} steps under gravity", MAX_SETTLE_SPEED)
+        if found is not None:
+            yield found
+
+
+def unstable_hit(states, when: str, fastest: float, blamed: str | None = None) -> Hit | None:
+    """One finding for one instability (P004, M004): the joints whose state is NaN/inf or faster than
+    ``fastest`` after settling, from ``states`` ((name, element, position, velocity) in file order), at
+    the joint the engine ``blamed`` (MuJoCo names the degree of freedom whose acceleration blew up) or
+    the first of them, naming the others (an exploding body drags every joint below it along: iCub's
+    one bad link made 27 findings)."""
+    bad = []
+    for name, element, position, velocity in states:
+        if not (math.isfinite(position) and math.isfinite(velocity)):
+            bad.append((name, element, "state is NaN/inf"))
+        elif abs(velocity) > fastest:
+            bad.append((name, element, f"moves at {velocity:.3g}"))
+    if not bad:
+        return None
+    first = next((state for state in states if state[0] == blamed), None)
+    if first is not None and first[0] not in [name for name, _element, _what in bad]:
+        bad.insert(0, (first[0], first[1], "made MuJoCo's accelerations blow up (the simulation was reset)"))
+    bad.sort(key=lambda item: item[0] != blamed)  # the blamed joint first, the rest in file order
+    name, element, what = bad[0]
+    others = [other for other, _element, _what in bad[1:]]
+    listed = ", ".join(f"'{other}'" for other in others[:UNSTABLE_LISTED]) + (", ..." if len(others) > UNSTABLE_LISTED else "")
+    also = f" (and {len(others)} more joint{'s' if len(others) != 1 else ''}: {listed})" if others else ""
+    return Hit(f"joint '{name}' {what} {when}{also}", element)
+
+
+UNSTABLE_LISTED = 3
+"""Other unstable joints a P004/M004 message names (the rest are counted)."""
 
 
 def _swinging_arm(limit: float) -> str:
@@ -203,6 +239,7 @@ def _swinging_arm(limit: float) -> str:
 
 
 @rule("P005", "sim-passes-through-parent", "warning", "A part passes through its parent when its joint moves",
+      engines=("pybullet",),
       why="""PyBullet never tests a link against its direct parent for self-collision and MoveIt calls
       the pair adjacent, so a child that swings through its parent's body is seen by no other check,
       and the robot's planners happily command poses the real robot cannot reach. ar3cli sweeps each

@@ -150,7 +150,7 @@ def _schema_elements(ctx) -> tuple:
     return ctx.shared("schema-elements", lambda model: tuple(node[0] for node in _schema_nodes(ctx)))
 
 
-def _owner(element) -> str:
+def owner(element) -> str:
     """"link 'arm' <visual> <origin>" for messages."""
     path, node = [], element
     while node is not None and node.tag not in ("link", "joint", "material", "robot"):
@@ -178,8 +178,9 @@ def _unknown_children(ctx) -> Iterator[tuple]:
                 continue
             if tag in attrs:
                 continue  # S018: an attribute written as an element
-            guess = _closest(tag, children)
-            if guess is None and (element_tag == "robot" or not _home_of(tag)):
+            # a URDF element's own name is no misspelling: it is in the wrong place (<inertial> under <robot>)
+            guess = None if tag in SCHEMA else _closest(tag, children)
+            if guess is None and (element_tag == "robot" and tag not in SCHEMA or not _home_of(tag)):
                 continue  # an extension (<gazebo>, <sensor>, <joint_properties>, ...), not a misspelling
             yield element, child, guess
 
@@ -209,7 +210,7 @@ def unknown_element(ctx) -> Iterator[Hit]:
         else:
             advice = f"<{child.tag}> belongs in <{'> or <'.join(homes)}>"
             hint = f"Move <{child.tag}> into <{homes[0]}>."
-        yield Hit(f"{_owner(parent)} has an unknown child <{child.tag}> ({advice}): {WHAT_PARSERS_DO}", child,
+        yield Hit(f"{owner(parent)} has an unknown child <{child.tag}> ({advice}): {WHAT_PARSERS_DO}", child,
                   hint=hint)
 
 
@@ -223,7 +224,8 @@ def unknown_element(ctx) -> Iterator[Hit]:
       bad=arm().replace('<axis xyz="0 0 1"/>', '<axis xzy="0 0 1"/>'),
       good=arm(),
       thresholds="Reported: a misspelling of an allowed attribute the element does not also have (difflib similarity "
-                 ">= 0.6, lengths within 2); iyx, izx, izy are ixy, ixz, iyz (the tensor is symmetric). Other unknown "
+                 ">= 0.6, lengths within 2); iyx, izx, izy are ixy, ixz, iyz (the tensor is symmetric): alone they are "
+                 "reported, next to their twin only when the two values differ. Other unknown "
                  "attributes are taken for extensions (ANYmal's command_effort, Isaac's dont_collapse).",
       references="wiki.ros.org/urdf/XML (link, joint); urdfdom xsd/urdf.xsd; urdfdom urdf_parser/src/pose.cpp, "
                  "joint.cpp, link.cpp.")
@@ -240,11 +242,29 @@ def unknown_attribute(ctx) -> Iterator[Hit]:
             guess = _closest(name, attrs)
             if guess is None or (guess in element.attrib and name not in INERTIA_SYMMETRY):
                 continue  # an extension's attribute (command_effort, dont_collapse, twist), not a misspelling
-            yield Hit(f"{_owner(element)} has an unknown attribute {name}=\"{element.get(name)}\" (did you mean "
+            if guess in element.attrib:  # iyx next to ixy: the tensor's redundant twin
+                if _same_number(element.get(name), element.get(guess)):
+                    continue  # written twice, read once: nothing is lost
+                yield Hit(f"{owner(element)} has {name}=\"{element.get(name)}\" and {guess}=\"{element.get(guess)}\": the "
+                          f"tensor is symmetric, parsers read {guess} and ignore {name}", element,
+                          hint=f"Keep the value you mean in {guess}= and delete {name}=.")
+                continue
+            yield Hit(f"{owner(element)} has an unknown attribute {name}=\"{element.get(name)}\" (did you mean "
                       f"{guess}?): {WHAT_PARSERS_DO}", element, hint=f"Rename {name}= to {guess}=.")
 
 
+def _same_number(a: str | None, b: str | None) -> bool:
+    """Whether two attribute texts hold the same number ("0" and "0.0"), or the same text."""
+    try:
+        return float(a or "") == float(b or "")
+    except ValueError:
+        return (a or "").strip() == (b or "").strip()
+
+
 @rule("S018", "attribute-as-element", "error", "Attribute written as a child element",
+      refused_by=("ros", "pybullet"),
+      breaks="urdfdom and PyBullet refuse a <limit> whose required value is written only as an element; every "
+             "engine silently drops a damping or friction written so (Drake #18796).",
       why="""<dynamics><damping>5</damping></dynamics> and <limit><effort>10</effort></limit> look
       right but URDF values are attributes: urdfdom, PyBullet and MuJoCo read damping="..." and
       never look at a child element, so the joint gets no damping (Drake #18796); a <limit> whose
@@ -264,7 +284,7 @@ def attribute_as_element(ctx) -> Iterator[Hit]:
             if tag not in attrs or tag in SCHEMA[element_tag][1]:
                 continue
             value = " ".join((child.text or "").split()) or "..."
-            yield Hit(f"{_owner(element)} has <{tag}> as a child element: parsers read only the attribute "
+            yield Hit(f"{owner(element)} has <{tag}> as a child element: parsers read only the attribute "
                       f"{tag}=\"...\" and ignore the element", child,
                       hint=f"Write <{element.tag} {tag}=\"{value}\" .../> and delete the <{tag}> element.")
 
@@ -275,6 +295,10 @@ parseInertial: "Inertial element must have a mass element", "... inertia element
 
 
 @rule("S019", "missing-required-child", "error", "<visual>/<collision> without <geometry>, <inertial> without <mass>",
+      engines=("ros", "pybullet", "isaac"),
+      refused_by=("ros", "pybullet", "isaac"),
+      breaks="urdfdom refuses the link and the file, PyBullet fails to parse the link, Isaac Sim's importer "
+             "fails (IsaacSim #599).",
       why="""urdfdom refuses a <visual> or <collision> without <geometry> and an <inertial> without
       <mass> or <inertia>, and with it the whole file ("failed to parse link"); Isaac Sim's importer
       fails the same way with no location (IsaacSim #599); PyBullet's --sim load says only "failed to
@@ -294,9 +318,10 @@ def missing_required_child(ctx) -> Iterator[Hit]:
         if element_tag == "inertial" and link is not None and link.get("name") in moving:
             continue  # I003 (mass) and I006 (inertia) report moving links
         present = {child_tag for _child, child_tag in element_children}
-        for tag in required:
-            if tag not in present:  # element.find(tag) is None
-                yield Hit(f"{_owner(element)} has no <{tag}>: urdfdom refuses the link, and the file", element)
+        missing = [tag for tag in required if tag not in present]  # element.find(tag) is None
+        if missing:  # one finding per element, whatever it lacks
+            yield Hit(f"{owner(element)} has no {' and no '.join(f'<{tag}>' for tag in missing)}: urdfdom refuses "
+                      "the link, and the file", element)
 
 
 VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "deceleration": "limit", "jerk": "limit"}
@@ -306,6 +331,7 @@ VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
 
 
 @rule("S020", "undeclared-urdf-version", "info", "URDF 1.1/1.2 attribute in a file that does not declare it",
+      engines=("ros",),
       why="""<origin quat_xyzw> is URDF 1.1, acceleration/deceleration/jerk on <limit> URDF 1.2. In a
       file without <robot version="1.1"> (or "1.2") urdfdom 5.1+ ignores them (a quat_xyzw frame stays
       unrotated for ROS tools while ar3cli, which reads it, rotates it), and older urdfdom does not know
@@ -325,6 +351,6 @@ def undeclared_urdf_version(ctx) -> Iterator[Hit]:
         for name in element.keys():  # noqa: SIM118 - an lxml element: iterating it gives its children
             if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
-                yield Hit(f"{_owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
+                yield Hit(f"{owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
                           "(urdfdom ignores it)", element,
                           hint=f'Declare <robot name="..." version="{major}.{minor}"> (or later).')

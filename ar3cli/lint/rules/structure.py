@@ -14,12 +14,14 @@ PYBULLET_JOINT_TYPES = ("spherical",)
 
 
 @rule("S001", "robot-name", "error", "<robot> has no name",
-      why="urdfdom (check_urdf, ROS robot_state_publisher) refuses a <robot> without a name attribute.",
+      engines=("ros",), refused_by=("ros",), breaks="urdfdom (check_urdf, robot_state_publisher) refuses the file.",
+      why="""urdfdom (check_urdf, ROS robot_state_publisher) refuses a <robot> without a name attribute. An
+      empty <robot> (no links either) is S011's, which says the name is missing too.""",
       fix='Add name="..." to <robot>.',
       bad='<?xml version="1.0"?>\n<robot>\n  <link name="base"/>\n</robot>\n',
       good=robot('<link name="base"/>'))
 def robot_name(ctx) -> Iterator[Hit]:
-    if not (ctx.model.root.get("name") or "").strip():
+    if not (ctx.model.root.get("name") or "").strip() and ctx.model.links:  # an empty <robot> is S011's
         yield Hit("<robot> has no name attribute", ctx.model.root)
 
 
@@ -37,6 +39,7 @@ def _duplicates(elements, kind: str) -> Iterator[Hit]:
 
 
 @rule("S002", "duplicate-link", "error", "Duplicate or missing link name",
+      refused_by=("ros",), breaks="urdfdom refuses the file; PyBullet and yourdfpy silently pick one of the links.",
       why="""Joints refer to links by name; with two links of the same name urdfdom refuses the file,
       and tools that accept it (PyBullet, yourdfpy) silently pick one of them.""",
       fix="Rename or remove one of the links.",
@@ -47,6 +50,7 @@ def duplicate_link(ctx) -> Iterator[Hit]:
 
 
 @rule("S003", "duplicate-joint", "error", "Duplicate or missing joint name",
+      refused_by=("ros",), breaks="urdfdom refuses the file.",
       why="""Controllers, mimic tags and transmissions refer to joints by name; duplicates make those
       references ambiguous and urdfdom refuses the file.""",
       fix="Rename or remove one of the joints.",
@@ -63,6 +67,7 @@ def duplicate_joint(ctx) -> Iterator[Hit]:
 
 
 @rule("S004", "missing-link", "error", "Joint names a link that does not exist",
+      refused_by=("ros", "pybullet"), breaks="urdfdom and PyBullet refuse the file.",
       why="A joint whose <parent> or <child> is missing or names an unknown link cannot be built by any tool.",
       fix="Fix the link name (check the spelling) or add the link.",
       bad=robot("""
@@ -82,6 +87,7 @@ def missing_link(ctx) -> Iterator[Hit]:
 
 
 @rule("S005", "several-roots", "error", "Several root links or orphan links",
+      refused_by=("ros",), breaks="urdfdom refuses the file; PyBullet silently drops every tree but one.",
       why="""A URDF is one tree with exactly one root. A link that no joint connects is a second root:
       urdfdom refuses the file, PyBullet loads only one tree and drops the rest without a word.""",
       fix="Connect the orphan link with a joint, or delete it.",
@@ -105,6 +111,7 @@ def several_roots(ctx) -> Iterator[Hit]:
 
 
 @rule("S006", "not-a-tree", "error", "Link with two parents, or a kinematic cycle",
+      refused_by=("ros",), breaks="check_urdf crashes (urdfdom 3.0 segfaults); other tools build a broken tree.",
       why="""URDF describes a tree: every link but the root has exactly one parent joint. A link with
       two parents or a loop crashes check_urdf (segfault in urdfdom 3.0) and is silently broken in
       other tools.""",
@@ -149,6 +156,10 @@ def not_a_tree(ctx) -> Iterator[Hit]:
 
 
 @rule("S007", "unknown-joint-reference", "error", "Reference to a joint or link that does not exist",
+      engines=("drake", "ros", "gazebo"),
+      refused_by=("drake", "gazebo"),
+      breaks="Drake refuses a mimic of a joint that does not exist; gazebo_ros_control refuses to start on a "
+             "transmission that names one.",
       why="""A <mimic joint="...">, a <transmission> <joint name="...">, a <ros2_control> <joint
       name="..."> or a <gazebo reference="..."> that names no joint (or link) is ignored by some
       tools and an error in others: ros_control and ros2_control refuse to start, Drake refuses a
@@ -204,6 +215,7 @@ def undefined_material(ctx) -> Iterator[Hit]:
 
 
 @rule("S009", "joint-type", "error", "Joint type missing or unknown",
+      refused_by=("ros", "pybullet"), breaks='urdfdom and PyBullet refuse the file ("Joint type not supported").',
       why="""The type must be one of revolute, continuous, prismatic, fixed, floating, planar.
       urdfdom refuses anything else; PyBullet refuses the file with "Joint type not supported".""",
       fix="Use one of: " + ", ".join(JOINT_TYPES) + ".",
@@ -216,6 +228,7 @@ def joint_type(ctx) -> Iterator[Hit]:
 
 
 @rule("S010", "pybullet-joint-type", "warning", "Joint type only PyBullet understands",
+      engines=("ros", "mujoco", "isaac", "drake", "gazebo"),
       why="""PyBullet accepts type="spherical" (a ball joint), but it is not part of URDF: urdfdom,
       ROS, MoveIt and yourdfpy refuse the file.""",
       fix="Keep the file PyBullet-only, or replace the ball joint by three revolute joints with massless links.",
@@ -227,6 +240,8 @@ def pybullet_joint_type(ctx) -> Iterator[Hit]:
 
 
 @rule("S011", "no-links", "error", "<robot> has no links",
+      refused_by=("ros", "pybullet"),
+      breaks='urdfdom refuses the file ("No link elements found") and PyBullet cannot load it.',
       why="""A robot is a tree of links. urdfdom refuses a file without one ("No link elements found in
       urdf file") and PyBullet cannot load it; an empty <robot> is usually a xacro argument or macro
       that expanded to nothing.""",
@@ -235,7 +250,8 @@ def pybullet_joint_type(ctx) -> Iterator[Hit]:
       good=robot('<link name="base"/>'))
 def no_links(ctx) -> Iterator[Hit]:
     if not ctx.model.links:
-        yield Hit("<robot> has no <link> elements", ctx.model.root)
+        unnamed = "" if (ctx.model.root.get("name") or "").strip() else " (and no name)"
+        yield Hit(f"<robot> has no <link> elements{unnamed}: nothing to load", ctx.model.root)
 
 
 def _transmissions(model):
@@ -262,6 +278,7 @@ def _transmission_robot(second: str) -> str:
 
 
 @rule("S012", "transmission-fixed-joint", "warning", "Transmission on a fixed joint",
+      engines=("drake", "gazebo", "ros"),
       why="""A fixed joint has nothing to drive. Drake skips the transmission ("Skipping transmission
       since it's attached to a fixed joint"); Gazebo merges fixed joints away when it converts the
       URDF, so gazebo_ros_control refuses to start ("This robot has a joint named ... which is not in
@@ -282,6 +299,10 @@ def transmission_fixed_joint(ctx) -> Iterator[Hit]:
 
 
 @rule("S013", "duplicate-actuator", "error", "Two transmissions name the same actuator",
+      engines=("drake", "ros"),
+      refused_by=("drake",),
+      breaks="Drake refuses the file (actuator names must be unique); ros_control sends one joint's commands to "
+             "the other.",
       why="""A SimpleTransmission couples one actuator to one joint. Two of them that name the same
       actuator make two motors of one: Drake refuses the file ("already contains a joint actuator
       named ... Joint actuator names must be unique"), and ros_control registers the actuator twice,
@@ -370,6 +391,7 @@ def _owner_name(element) -> str:
 
 
 @rule("S015", "link-order", "info", "Root link not first, or a link declared before its parent",
+      engines=("pybullet",),
       why="""URDF does not order links, and ar3cli does not care (it hands pybullet a reordered copy).
       But pybullet loaded with URDF_MAINTAIN_LINK_ORDER, which keeps link indices in file order,
       crashes in C (SIGSEGV, no message) when the root is not the first <link> (every UR file of

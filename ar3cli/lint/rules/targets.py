@@ -11,10 +11,10 @@ from collections import deque
 from collections.abc import Iterator
 from pathlib import PurePosixPath
 
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
+from ar3cli.lint.rules.base import ENGINES, LINK_INERTIAL, Hit, arm, robot, rule
 
-TARGETS = ("pybullet", "ros", "mujoco", "isaac", "drake", "gazebo")
-"""Engines ``--target`` accepts."""
+TARGETS = ENGINES
+"""Engines ``--target`` accepts: the ones a rule can be about."""
 DEFAULT_TARGETS = ("pybullet", "ros")
 
 _MIMIC = arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/>').replace(
@@ -225,3 +225,37 @@ def drake_ignores(ctx) -> Iterator[Hit]:
         if "SimpleTransmission" not in kind:
             yield Hit(f"transmission '{transmission.get('name', '?')}' type '{kind.strip()}': Drake reads only "
                       "SimpleTransmission and ignores it", transmission)
+
+
+def _quat_arm(quat: str) -> str:
+    return arm(joint_extra=f'<origin xyz="0 0 0.1" quat_xyzw="{quat}"/><limit lower="-1" upper="1" effort="10" '
+                           'velocity="1"/>').replace('<robot name="r">', '<robot name="r" version="1.1">')
+
+
+@rule("T009", "pybullet-quat-ignored", "warning", "<origin quat_xyzw>: PyBullet ignores it",
+      why="""URDF 1.1 lets an <origin> give its orientation as quat_xyzw. PyBullet 3.2.7 does not read
+      it: the joint, visual, collision and inertial frames load unrotated (measured: every link frame
+      of tests/data/urdf12/arm_quat.urdf comes back as the identity, where its rpy twin is rotated).
+      The robot is assembled wrongly in PyBullet without a word. ar3cli's own PyBullet runs convert the
+      quaternion to rpy first; your code calling loadURDF does not. An rpy given as well wins in every
+      reader, and the identity quaternion changes nothing: neither is reported.""",
+      fix="Write the orientation as rpy (ar3cli reads the quaternion: `ar3cli info` shows the frames), or keep "
+          "quat_xyzw for ROS and convert before loading in PyBullet.",
+      bad=_quat_arm("0 0 0.7071068 0.7071068"), good=_quat_arm("0 0 0 1"),
+      targets=("pybullet",),
+      references="pybullet 3.2.7 (measured; UrdfParser.cpp parses xyz and rpy only); docs/pybullet-facts.md; "
+                 "ar3cli/sim/loadable_copy.py.")
+def pybullet_quat_ignored(ctx) -> Iterator[Hit]:
+    from ar3cli.lint.rules.units import origins
+    from ar3cli.urdf.model import read_quaternion
+
+    for element, where in origins(ctx.model):
+        quat = element.get("quat_xyzw")
+        if quat is None or element.get("rpy") is not None:
+            continue
+        read = read_quaternion(quat)
+        if read is None or abs(abs(read[0][3]) - 1.0) < 1e-12:
+            continue  # unusable (F007's) or the identity: nothing is lost
+        rpy = " ".join(f"{v:.6g}" for v in read[1])
+        yield Hit(f"{where} <origin quat_xyzw=\"{quat}\">: PyBullet ignores it and loads the frame unrotated "
+                  f"(rpy=\"{rpy}\" says the same for every reader)", element, hint=f'Write rpy="{rpy}" instead.')

@@ -1,0 +1,124 @@
+"""Quiet where nothing is wrong, and one cause reported once (issue 35): each false-alarm class of the
+issue on a small fixture of tests/data/quiet/ (README.md there says where each pattern comes from)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from ar3cli.findings import Severity
+from ar3cli.lint.engine import LintOptions, lint_file
+
+DATA = Path(__file__).parent / "data" / "quiet"
+
+
+def _lint(name: str, select=("ALL",), targets=("pybullet", "ros"), sim: bool = False, engines=("pybullet",)) -> list:
+    options = LintOptions(select=list(select), targets=targets, sim=sim, engines=engines)
+    return lint_file(DATA / name, options.rules(), options).findings
+
+
+def _codes(findings) -> list[str]:
+    return [f.rule for f in findings]
+
+
+def _line(name: str, needle: str) -> int:
+    return next(i for i, line in enumerate((DATA / name).read_text().splitlines(), 1) if needle in line)
+
+
+def test_a_redundant_inertia_twin_is_quiet_and_a_contradicting_one_is_reported():
+    (finding,) = [f for f in _lint("inertia_twins.urdf") if f.rule == "S017"]
+    assert finding.line == _line("inertia_twins.urdf", 'iyx="0.004"')
+    assert "iyx=\"0.004\" and ixy=\"0\"" in finding.message and "parsers read ixy" in finding.message
+
+
+def test_a_two_slash_file_uri_is_relative():
+    assert _lint("file_uri_relative.urdf") == []
+
+
+def test_a_mimic_follower_has_no_actuator_of_its_own():
+    findings = _lint("mimic_gripper.urdf")
+    assert "J008" not in _codes(findings)
+    assert "T001" in _codes(findings)  # PyBullet's loadURDF still ignores the <mimic>: that is said
+
+
+def test_placeholder_and_marker_visuals_need_no_collision_but_a_real_part_does():
+    (finding,) = [f for f in _lint("markers.urdf") if f.rule == "G008"]
+    assert "'bumper'" in finding.message
+
+
+def test_a_virtual_root_welded_to_a_body_with_inertia_is_an_info():
+    findings = _lint("virtual_root.urdf")
+    i006 = [f for f in findings if f.rule == "I006"]
+    assert [f.line for f in i006] == [_line("virtual_root.urdf", '<mass value="0.7"/>')]  # the hip is a point mass
+    welded = {f.message.split("'")[1]: f for f in findings if f.rule == "I008"}
+    assert set(welded) == {"base", "ankle"} and all(f.severity is Severity.INFO for f in welded.values())
+    assert "'trunk'" in welded["base"].message and "'foot'" in welded["ankle"].message
+
+
+def test_a_light_link_between_two_joints_is_carried_by_the_finger_below():
+    assert "I014" not in _codes(_lint("finger_cross.urdf"))
+
+
+def test_xacro_in_a_comment_needs_no_namespace():
+    assert _lint("commented_xacro.urdf") == []
+
+
+def test_meshes_mujoco_finds_through_its_meshdir():
+    mujoco_only = _lint("mujoco_meshdir/robot.urdf", targets=("mujoco",))
+    assert "G001" not in _codes(mujoco_only)
+    also_ros = [f for f in _lint("mujoco_meshdir/robot.urdf", targets=("mujoco", "ros")) if f.rule == "G001"]
+    assert len(also_ros) == 2 and all("only MuJoCo finds it" in f.message for f in also_ros)
+    default = [f for f in _lint("mujoco_meshdir/robot.urdf") if f.rule == "G001"]  # PyBullet and ROS do not
+    assert len(default) == 2 and all(f.severity is Severity.ERROR for f in default)
+
+
+def test_an_unexpanded_mesh_path_is_one_finding():
+    findings = _lint("unexpanded_mesh.urdf")
+    assert _codes(findings) == ["F006", "F006"]
+    assert "no tool can find the mesh" in findings[0].message
+
+
+def test_an_empty_robot_is_one_finding():
+    (finding,) = _lint("empty_robot.urdf")
+    assert finding.rule == "S011" and "no name" in finding.message
+
+
+def test_a_joint_that_cannot_move_is_one_finding():
+    (finding,) = [f for f in _lint("locked_joint.urdf") if f.rule.startswith("J")]
+    assert finding.rule == "J004" and "effort=0 and velocity=0" in finding.message
+
+
+def test_a_tensor_no_body_has_is_not_also_implausible():
+    assert [f.rule for f in _lint("bad_tensor.urdf") if f.rule.startswith("I")] == ["I005"]
+
+
+def test_an_inertial_without_children_is_one_finding_per_element():
+    findings = _lint("inertial_without_children.urdf")
+    assert _codes(findings) == ["S019", "S019"]
+    assert "no <mass> and no <inertia>" in findings[0].message and "no <inertia>" in findings[1].message
+
+
+def test_an_inertial_under_robot_belongs_in_a_link():
+    (finding,) = _lint("misplaced_inertial.urdf")
+    assert finding.rule == "S016" and "belongs in <link>" in finding.message and "material" not in finding.message
+
+
+def test_unexpanded_substitution_names_the_prefix_not_the_namespace_uri():
+    (finding,) = [f for f in _lint("xacro_in_urdf.urdf") if f.rule == "F006"]
+    assert "<xacro:property value=" in finding.message and "{http" not in finding.message
+
+
+@pytest.mark.slow
+def test_one_instability_is_one_finding(tmp_path, monkeypatch):
+    pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
+    monkeypatch.chdir(tmp_path)
+    findings = _lint("unstable_chain.urdf", select=("M004",), sim=True, engines=("mujoco",))
+    (finding,) = findings
+    assert finding.line == _line("unstable_chain.urdf", 'name="shoulder"') and "more joint" in finding.message
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()  # MuJoCo's warning did not become a file in the cwd
+
+
+def test_a_load_failure_a_static_error_explains_is_not_restated():
+    findings = _lint("mujoco_meshdir/robot.urdf", select=("G001", "P001"), sim=True)
+    assert set(_codes(findings)) == {"G001"}
