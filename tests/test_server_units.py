@@ -114,6 +114,7 @@ def test_open_files_keep_bounded_analyses_and_closed_ones_are_forgotten(tmp_path
             documents.record(check(Snapshot(path.as_uri(), path, version, ARM), settings))
     held = [document for document in documents.open.values() if document.loaded is not None]
     assert len(held) == KEPT_ANALYSES
+    assert sum(document.released for document in documents.open.values()) == 3  # made again when a feature asks
     assert all(document.checked.diagnostics for document in documents.open.values())  # diagnostics all stay
     for path in paths:
         changed, _ = documents.remove(path.as_uri())

@@ -47,6 +47,8 @@ class Document:
     sim: tuple[int | None, dict[str, list[types.Diagnostic]]] | None = None
     """The PyBullet rules' diagnostics and the version they were made for (the saved one)."""
     used: int = 0
+    released: bool = False
+    """Its analysis was let go to bound memory (a feature asking for it makes it again)."""
 
 
 @dataclass
@@ -90,6 +92,7 @@ class Documents:
             return set()
         changed = self._files_of(document) | set(checked.diagnostics) | {str(document.path)}
         document.checked = checked
+        document.released = False
         if checked.analysis is not None and checked.analysis.model is not None:
             document.loaded = checked.analysis
         for other in self.open.values():  # a file this one includes is checked through it from now on
@@ -146,6 +149,6 @@ class Documents:
                           or (document.checked is not None and document.checked.analysis is not None)),
                          key=lambda document: document.used, reverse=True)
         for document in holding[KEPT_ANALYSES:]:
-            document.loaded = None
+            document.loaded, document.released = None, True
             if document.checked is not None:
                 document.checked.analysis = None

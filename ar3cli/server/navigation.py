@@ -158,7 +158,10 @@ def definition(path: Path, text: str, position: types.Position, encoding: str, a
     if cursor.kind == "value" and cursor.tag == "xacro:include" and cursor.attribute == "filename":
         return [_file_location(target) for target in include_targets(cursor.value, path, analyses, related)]
     if cursor.kind == "tag" and cursor.tag.startswith("xacro:") and cursor.tag[6:] not in XACRO_BUILTINS:
-        return _xacro_definitions("macro", cursor.tag[6:], path, text, related, text_of, encoding)
+        name = cursor.tag[6:]  # seg.segment: the macro segment of a file included with ns="seg"
+        return _xacro_definitions("macro", name, path, text, related, text_of, encoding) or (
+            _xacro_definitions("macro", name.rsplit(".", 1)[1], path, text, related, text_of, encoding)
+            if "." in name else [])
     expression = expression_at(text, offset)
     name = identifier_at(text, offset)
     if expression is None or name is None:

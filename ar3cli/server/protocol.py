@@ -205,7 +205,7 @@ class RobotLanguageServer(LanguageServer):
     async def analyses(self, document: Document) -> list[Any]:
         """The analyses for a feature on ``document``; its own is made again when it was let go."""
         found = self.documents.analyses(document)
-        if found or (document.checked is not None and not document.checked.standalone):
+        if found or not document.released:
             return found
         text = self.text(document.uri)
         if text is None:
