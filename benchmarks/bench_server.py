@@ -2,8 +2,8 @@
 
 A real server process (``ar3cli server --debounce-ms 0``, the console script users run) is driven over
 its stdin/stdout by a minimal LSP client in this script: ``initialize``, ``didOpen`` of the robot,
-then keystrokes. A keystroke is one ``textDocument/didChange`` that types or deletes one character
-in a joint limit (``upper="1.57"`` <-> ``upper="1.5"``), and its time runs from the moment the
+then keystrokes. A keystroke is one ``textDocument/didChange`` that deletes or types back one character
+of a joint limit (``upper="1.57"`` -> ``upper="1.5"``, each keystroke another joint), and its time runs from the moment the
 message is written until the ``textDocument/publishDiagnostics`` for that version is read: the
 server's whole check (the buffer parsed into a model, lint-urdf's static rules with the workspace's
 configuration, the findings turned into ranged diagnostics) plus the JSON-RPC both ways. The debounce
@@ -19,8 +19,8 @@ first model) and warm-up keystrokes. After them, the server's resident memory af
 
 The generated robot (``--links``, default 300): a tree of revolute joints, six arms of 50 links off
 a base, each link with an inertial, a cylinder visual and collision, origin, axis and limits:
-no findings, so every rule runs to the end. ``--robot PATH`` times a real file instead (a
-keystroke then edits the first ``upper="..."`` of a ``<limit>``).
+no findings, so every rule runs to the end. ``--robot PATH`` times a real file instead (its
+``<limit upper="...">`` values are the ones edited).
 
 Usage (inside the project's venv)::
 
@@ -152,31 +152,33 @@ class Client:
 
 
 class Keystrokes:
-    """Edits of one ``upper="..."`` attribute: a character typed, then deleted, again and again."""
+    """Keystrokes on the ``upper="..."`` values of the ``<limit>`` elements: the k-th deletes the last
+    character of the k-th value (``1.57`` -> ``1.5``), and once every value had one, types them back,
+    so no two keystrokes of a run (fewer than twice the joints) give the same text: a check answered
+    from a cache of earlier texts could not pass for a check."""
 
     def __init__(self, text: str) -> None:
-        match = re.search(r'<limit\b[^>]*\bupper="([^"]*)"', text)
-        if match is None:
+        self.places = []
+        for match in re.finditer(r'<limit\b[^>]*\bupper="([^"]+)"', text):
+            line = text.count("\n", 0, match.start(1))
+            column = match.start(1) - (text.rfind("\n", 0, match.start(1)) + 1)
+            self.places.append((line, column + len(match.group(1)) - 1, match.group(1)[-1]))
+        if not self.places:
             raise SystemExit("the robot has no <limit upper=\"...\"> to edit")
-        self.line = text.count("\n", 0, match.start(1))
-        self.column = match.start(1) - (text.rfind("\n", 0, match.start(1)) + 1)
-        self.value = match.group(1)
         self.version = 1
-        self.typed = False
+        self.count = 0
 
     def next(self, uri: str) -> dict:
-        """The next didChange: one character typed at the end of the value, or deleted again."""
+        """The next didChange: one character deleted, or typed back."""
         self.version += 1
-        end = self.column + len(self.value)
-        if self.typed:
-            change = {"range": {"start": {"line": self.line, "character": end},
-                                "end": {"line": self.line, "character": end + 1}}, "text": ""}
-        else:
-            change = {"range": {"start": {"line": self.line, "character": end},
-                                "end": {"line": self.line, "character": end}}, "text": "1"}
-        self.typed = not self.typed
+        line, column, character = self.places[self.count % len(self.places)]
+        typing_back = (self.count // len(self.places)) % 2 == 1
+        self.count += 1
+        start = {"line": line, "character": column}
+        end = start if typing_back else {"line": line, "character": column + 1}
         return {"method": "textDocument/didChange", "params": {
-            "textDocument": {"uri": uri, "version": self.version}, "contentChanges": [change]}}
+            "textDocument": {"uri": uri, "version": self.version},
+            "contentChanges": [{"range": {"start": start, "end": end}, "text": character if typing_back else ""}]}}
 
 
 def keystroke(client: Client, keys: Keystrokes, uri: str) -> tuple[float, float, int]:
@@ -269,11 +271,17 @@ def breakdown(path: Path, text: str, runs: int) -> str:
     whole-process numbers above are): the buffer loaded into a model, lint-urdf's static rules on it,
     the findings turned into diagnostics."""
     sys.path.insert(0, str(_timing.REPO))
+    import gc
+
     from ar3cli.analysis.findings import static_findings
     from ar3cli.analysis.robot import RobotAnalysis
     from ar3cli.analysis.settings import AnalysisSettings
+    from ar3cli.cli import GC_ALLOCATIONS
     from ar3cli.server.checks import Snapshot, diagnostics_by_file
 
+    gc.set_threshold(GC_ALLOCATIONS, *gc.get_threshold()[1:])  # as the server process has it (ar3cli.cli.run)
+    gc.collect()
+    gc.freeze()  # as the server does once it has imported what a check needs (ar3cli.server.launch)
     settings = AnalysisSettings()
     steps: dict[str, list[float]] = {"load the buffer (parse, model)": [], "lint-urdf's static rules": [],
                                      "findings to diagnostics (ranges)": []}
@@ -292,7 +300,33 @@ def breakdown(path: Path, text: str, runs: int) -> str:
     lines = ["", f"in-process breakdown of one check (CPU time, median of {runs}; this process, same text):", "",
              "| step | CPU ms |", "|---|---:|"]
     lines += [f"| {name} | {1e3 * statistics.median(values):.1f} |" for name, values in steps.items()]
-    return "\n".join(lines) + "\n"
+    return "\n".join(lines) + "\n" + rule_costs(analysis, runs)
+
+
+SHOWN_RULES = 10
+
+
+def rule_costs(analysis, runs: int) -> str:
+    """Each static rule's CPU time on the analysed model, one Context shared as the engine shares it
+    (median of ``runs``): the rules worth making cheaper first."""
+    from ar3cli.lint.context import Context
+
+    rules = [rule for rule in analysis.settings.lint_options(False).rules() if rule.check is not None]
+    spent: dict[str, list[float]] = {rule.code: [] for rule in rules}
+    for _ in range(runs):
+        context = Context(analysis.model)
+        for rule in rules:
+            start = time.process_time()
+            for _hit in rule.check(context):
+                pass
+            spent[rule.code].append(time.process_time() - start)
+        context.close()
+    medians = sorted(((statistics.median(values), code) for code, values in spent.items()), reverse=True)
+    total = sum(value for value, _ in medians)
+    shown = ", ".join(f"{code} {1e3 * value:.1f}" for value, code in medians[:SHOWN_RULES])
+    rest = sum(value for value, _ in medians[SHOWN_RULES:])
+    return (f"\nthe {len(rules)} static rules, CPU ms each (median of {runs}, one shared Context): "
+            f"{1e3 * total:.0f} in all; {shown}; the other {len(medians) - SHOWN_RULES} together {1e3 * rest:.1f}\n")
 
 
 if __name__ == "__main__":

@@ -90,8 +90,8 @@ def plan(analysis: RobotAnalysis, command: str) -> Planned | None:
         from ar3cli.errors import UserError
         from ar3cli.urdf.edits import Document
 
-        fixer, options = _fixer(command, analysis)
         try:
+            fixer, options = _fixer(command, analysis)
             document = Document(model.source_bytes)
             document.bind(model.root)
             made = fixer.plan(model, document, options)
