@@ -170,6 +170,9 @@ def steps(smoke: Smoke, work: Path) -> None:
     for name, args in (("cross-check (no mujoco)", ["cross-check", str(robot)]),
                        ("lint-urdf --engine mujoco (no mujoco)", ["lint-urdf", "--sim", "--engine", "mujoco", str(robot)])):
         smoke.run(name, args, expect=(2,), check=needs("pip install 'ar3cli[mujoco]'"))
+    smoke.run("server (no pygls)", ["server"], expect=(2,),
+              check=lambda r: None if "pip install 'ar3cli[server]'" in r.stderr and len(r.stderr.splitlines()) == 1
+              and not r.stdout else "not one line naming pip install 'ar3cli[server]'")
 
     def fixed_copy(name: str) -> Path:
         return make_robot(work / name)

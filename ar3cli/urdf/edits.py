@@ -188,6 +188,12 @@ class Document:
     def changed(self) -> bool:
         return bool(self._splices)
 
+    @property
+    def splices(self) -> list[tuple[int, int, bytes]]:
+        """The pending splices ``(start, end, new)`` in file order, as :meth:`apply` makes them: what
+        an editor applies as text edits instead of the whole new file (``ar3cli server``'s quick fixes)."""
+        return sorted(self._splices, key=lambda s: (s[0], s[1]))
+
 
 def _escape(value: str, quote: str) -> str:
     """An attribute value escaped for a given quote character."""

@@ -82,6 +82,18 @@ def _package_xml_name(folder: Path, _state: PathState | None = None) -> str | No
     return match.group(1).decode("utf-8", "replace") if match else None
 
 
+def enclosing_package(folder: Path) -> tuple[str, Path] | None:
+    """The package a file in ``folder`` belongs to: the nearest folder from ``folder`` up that holds a
+    ``package.xml`` with a ``<name>``, as (name, that folder); None when there is none. This is the
+    package :class:`PackageResolver` finds for ``package://NAME/...`` from the file (its rule 4)."""
+    for ancestor in [folder, *folder.parents]:
+        manifest = ancestor / "package.xml"
+        name = _package_xml_name(ancestor, path_state(str(manifest)))
+        if name:
+            return name, ancestor
+    return None
+
+
 PYBULLET_SEARCH_LEVELS = 64
 """How many folders above the robot file PyBullet's fallback search climbs: all of them (pybullet 3.2.7
 found ``pkg/meshes/m.obj``, ``package://pkg/meshes/m.obj`` and ``package:///pkg/meshes/m.obj`` from a
