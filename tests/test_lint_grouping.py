@@ -1,5 +1,7 @@
-"""Grouping in lint-urdf's text table: 3 or more alike findings of one rule in one file become one
-row (count, first locations, the first message); --group/--no-group; other formats keep every finding."""
+"""Grouping in lint-urdf's text output: 5 or more alike findings of one rule in one file become one
+row or line (count, first locations, the first message); --group/--no-group; JSON keeps every
+finding, the CI formats (github, markdown, sarif, junit) show one annotation, row, result or test
+case per rule and file (issue 36, item 2)."""
 
 from __future__ import annotations
 
@@ -62,19 +64,23 @@ def test_cli_group_and_no_group(cli, write_urdf):
     path = str(write_urdf(chain(5)))
     grouped = cli("lint-urdf", path, "--group", "--no-cache")
     assert grouped.code == 1
-    rows = [line for line in grouped.stdout.splitlines() if "| J001 |" in line]
+    rows = [line for line in grouped.stdout.splitlines() if " J001 [error] " in line]  # piped: a line per row
     assert len(rows) == 1 and "5x: revolute joint 'j0' has no <limit> (and 4 more like it); at " in rows[0]
     assert "FAILED: 1 file checked, 5 errors" in grouped.stdout  # the summary counts every finding
     every = cli("lint-urdf", path, "--no-group")
-    assert every.stdout.count("| J001 |") == 5
+    assert every.stdout.count(" J001 [error] ") == 5
+    assert cli("lint-urdf", path, "--no-group", "--wide").stdout.count("| J001 |") == 5
     assert cli("lint-urdf", path, "--no-cache").stdout == grouped.stdout  # grouped by default, terminal or not
 
 
-def test_other_formats_keep_every_finding(cli, write_urdf):
+def test_json_keeps_every_finding_and_ci_formats_group_by_rule_and_file(cli, write_urdf):
     path = str(write_urdf(chain(4)))
     document = json.loads(cli("lint-urdf", path, "--group", "--format", "json").stdout)
     assert len(document["findings"]) == 4 and document["summary"]["findings"] == 4
     sarif = json.loads(cli("lint-urdf", path, "--group", "--format", "sarif").stdout)
-    assert len(sarif["runs"][0]["results"]) == 4
-    assert cli("lint-urdf", path, "--group", "--format", "github").stdout.count("title=J001") == 4
-    assert cli("lint-urdf", path, "--group", "--format", "markdown").stdout.count("| J001 |") == 4
+    (result,) = sarif["runs"][0]["results"]
+    assert len(result["relatedLocations"]) == 3 and "4 findings of J001" in result["message"]["text"]
+    assert cli("lint-urdf", path, "--group", "--format", "github").stdout.count("title=J001") == 1
+    assert cli("lint-urdf", path, "--group", "--format", "markdown").stdout.count("| J001 |") == 1
+    every = cli("lint-urdf", path, "--no-group", "--format", "github").stdout
+    assert every.count("title=J001") == 4

@@ -38,6 +38,21 @@ CREATE INDEX IF NOT EXISTS files_status ON files(status);
 """
 
 
+def storable(text: str) -> str:
+    """``text`` as the store keeps it: a file name that is not UTF-8 (Python holds its bytes as lone
+    surrogates, which SQLite cannot take) with those bytes written ``\\xff``, as ar3cli shows them;
+    every other text as it is."""
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        pass
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # a surrogate that is no file-name byte
+        return text.encode("utf-8", "backslashreplace").decode("utf-8")
+
+
 class Store:
     """An open scan store; use as a context manager. ``readonly`` opens an existing store for a report."""
 
@@ -73,7 +88,8 @@ class Store:
 
     def put(self, rows: Iterable[Row], now: float) -> int:
         """Write ``rows`` in one transaction (all or none); a row replaces the one with its path."""
-        values = [(row.path, row.sha256, row.settings, row.status, row.findings_json(), row.message, row.dof,
+        values = [(storable(row.path), row.sha256, row.settings, row.status, row.findings_json(), storable(row.message),
+                   row.dof,
                    row.mass, row.links, row.joints, row.load_seconds, row.check_seconds,
                    *(row.counts()[level] for level in ("error", "warning", "info")), now) for row in rows]
         marks = ", ".join("?" * len(_COLUMNS))

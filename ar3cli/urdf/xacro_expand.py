@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import NamedTuple
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.infra.safe_read import MAX_FILE_BYTES
 from ar3cli.output.report import log
 from ar3cli.urdf.packages import PackageResolver
@@ -163,7 +164,7 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
     def find_package(name: str) -> str:
         folder, tried = resolver.find_package(name)
         if folder is None:
-            failures.append(UserError(f"{path}: $(find {name}): package not found; tried {', '.join(tried)}; "
+            failures.append(UserError(f"{path}: $(find {name}): package not found; tried {listed(tried)}; "
                                       f"pass --package-path {name}=DIR"))
             raise failures[-1]
         roots.add_package(folder)
@@ -196,7 +197,7 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
     finally:
         substitution_args._eval_find = original_find
         xacro.parse = original_parse
-    data = text.encode("utf-8")
+    data = text.encode("utf-8", "backslashreplace")  # xacro names the file in a comment: its name may not be UTF-8
     if len(data) > MAX_FILE_BYTES:
         raise UserError(f"{path}: xacro error: the expanded URDF is {len(data) / 1e6:.0f} MB, larger than the "
                         f"{MAX_FILE_BYTES >> 20} MB limit for robot descriptions")
@@ -244,7 +245,7 @@ def _arguments_hint(path: Path, given: dict[str, str]) -> str:
              if name not in given]
     if not names:
         return ""
-    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    shown = listed(names, 8)
     return f"; the file takes xacro arguments ({shown}): pass the ones it needs with --xacro-arg NAME:=VALUE"
 
 

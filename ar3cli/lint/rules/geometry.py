@@ -7,6 +7,7 @@ from collections.abc import Iterator
 from functools import lru_cache
 from pathlib import Path
 
+from ar3cli.findings import listed
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 
@@ -61,7 +62,7 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
-            tried = "; looked in " + ", ".join(resolution.tried) if resolution.tried else ""
+            tried = "; looked in " + listed(resolution.tried) if resolution.tried else ""
             yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{tried}",
                       geometry.element)
 
