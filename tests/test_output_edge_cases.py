@@ -153,6 +153,29 @@ def test_summary_fields_agree_with_the_counts_and_the_exit_code(cli, tmp_path):
     assert json.loads(zero.stdout)["summary"]["exit_code"] == zero.code == 0
 
 
+INFO_AND_WARNING = '<robot name="r"><link name="base"><visual><geometry><box size="1 1 1"/></geometry></visual></link></robot>'
+"""G008 (warning) and I012 (info), nothing at or above the default --fail-on."""
+
+
+def test_clean_means_nothing_at_or_above_fail_on_in_the_summary_json_and_scan(cli, tmp_path):
+    """Issue 36 item 4: lint --sim's P003 (info) on the bundled AR3 made the summary say "1 info; 0 clean"
+    and scan-report --keep clean keep nothing."""
+    (tmp_path / "bad.urdf").write_text(TWO_ERRORS)
+    (tmp_path / "info.urdf").write_text(INFO_AND_WARNING)
+    text = cli("lint-urdf", ".", "--no-cache", cwd=tmp_path).stdout
+    assert "1 warnings, 1 info; 1 clean (fail-on: error)" in text
+    summary = json.loads(cli("lint-urdf", ".", "--no-cache", "--format", "json", cwd=tmp_path).stdout)["summary"]
+    assert summary["files_clean"] == 1
+    strict = json.loads(cli("lint-urdf", ".", "--no-cache", "--format", "json", "--fail-on", "warning",
+                            cwd=tmp_path).stdout)["summary"]
+    assert strict["files_clean"] == 0
+    assert cli("scan", ".", "--store", "s.sqlite", cwd=tmp_path).code == 0
+    report = json.loads(cli("scan-report", "s.sqlite", "--keep", "clean", "--format", "json", cwd=tmp_path).stdout)
+    assert report["statuses"]["clean"] == 1 and report["statuses"]["findings"] == 1
+    assert [path.rsplit("/", 1)[-1] for path in report["keep"]["paths"]] == ["info.urdf"]
+    assert [row["path"].rsplit("/", 1)[-1] for row in report["worst"]] == ["bad.urdf", "info.urdf"]
+
+
 def test_a_file_not_checked_fails_the_summary():
     from ar3cli.findings import Severity
     from ar3cli.lint.engine import LintResult, summarize

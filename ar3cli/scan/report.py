@@ -26,7 +26,7 @@ def summarize(rows: list[Row], filters: list[Keep], top: int) -> dict[str, Any]:
         files.update(set(codes))
         for f in row.findings:
             severity.setdefault(f["rule"], f["severity"])
-    worst = sorted((row for row in rows if row.status != "clean"), key=severity_rank, reverse=True)[:top]
+    worst = sorted((row for row in rows if row.status != "clean" or row.findings), key=severity_rank, reverse=True)[:top]
     keep = kept(rows, filters)
     return {
         "files": len(rows),

@@ -16,7 +16,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.scan.record import Row
+from ar3cli.scan.record import LOADED, Row, status_of
 
 SCHEMA_VERSION = 1
 _COLUMNS = ("path", "sha256", "settings", "status", "findings", "message", "dof", "mass", "links", "joints",
@@ -102,7 +102,10 @@ class Store:
         query = f"SELECT {', '.join(_COLUMNS[:12])} FROM files ORDER BY path"
         try:
             for record in self.db.execute(query):
-                yield Row(*record[:4], json.loads(record[4]), *record[5:])  # type: ignore[arg-type]
+                row = Row(*record[:4], json.loads(record[4]), *record[5:])  # type: ignore[arg-type]
+                if row.status in LOADED:  # a store written when "clean" meant no finding at all reads as today
+                    row.status = status_of(True, row.findings, None)
+                yield row
         except sqlite3.DatabaseError as exc:
             raise UserError(f"{self.path}: cannot read the scan store ({exc})") from None
 
