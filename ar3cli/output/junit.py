@@ -33,14 +33,19 @@ LISTED = 100
 """Findings one test case's text lists at most (the rest counted)."""
 
 
-def _describe(finding: Finding) -> str:
+def _describe(finding: Finding, hint: bool = True) -> str:
     text = xml_text(f"{finding.location}: {finding.severity.value} {finding.rule}: {finding.message}")
-    return text + (f"\n  fix: {xml_text(finding.hint)}" if finding.hint else "")
+    return text + (f"\n  fix: {xml_text(finding.hint)}" if finding.hint and hint else "")
 
 
 def _describe_group(group: RuleGroup) -> str:
+    """Every finding of the group (at most :data:`LISTED`); their fix once when they share it."""
     shown, left = capped(group.findings, LISTED)
-    return "\n".join([*map(_describe, shown), *([f"and {left:,} more"] if left else [])])
+    shared = len({finding.hint for finding in group.findings}) == 1
+    lines = [_describe(finding, hint=not shared) for finding in shown] + ([f"and {left:,} more"] if left else [])
+    if shared and group.first.hint:
+        lines.append(f"  fix: {xml_text(group.first.hint)}")
+    return "\n".join(lines)
 
 
 def junit_document(files: Iterable[tuple[str, list[Finding], str | None]], fail_on: Severity,

@@ -2,14 +2,16 @@
 
 Text goes to a rich console on a terminal (tables with colour, without it when ``NO_COLOR`` is
 set), fitted to its width (``COLUMNS`` wins): long cells wrap inside their column. Off a terminal
-(pipes, CI logs, pre-commit) tables are plain ASCII, one line per row (what grep and log viewers
-want), unless ``COLUMNS`` is set: then they fit that width the same way; rich is not even imported
-unless the report holds rich renderables. ``Report.wide`` (lint-urdf's ``--wide``) asks for one
-line per row everywhere. Names from robot files (paths, links, joints) reach text output through
-:func:`printable`, so a control character in them (a terminal escape sequence, ``\\r``, a bidi
-override) is shown as ``\\x1b``, never obeyed by the terminal; JSON keeps the exact strings. JSON goes to stdout alone, so
-``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing to write
-the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
+(pipes, CI logs, pre-commit) tables are plain ASCII fitted to ``COLUMNS``, or to
+:data:`PIPED_WIDTH` (100) when it is not set, and lint findings are one line each
+(:mod:`ar3cli.output.formats.text`); rich is not even imported unless the report holds rich
+renderables. ``Report.wide`` (lint-urdf's ``--wide``) asks for one line per row everywhere. Names
+from robot files, file names and the environment reach text output through :func:`printable`
+(:func:`ar3cli.output.escape.terminal`), so a control character in them (a newline, a terminal
+escape sequence, ``\\r``, a bidi override) is shown as ``\\x1b``, never obeyed; JSON keeps the exact
+strings. Tables show at most :data:`~ar3cli.output.lists.TABLE_ROWS` rows. JSON goes to stdout
+alone, so ``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing
+to write the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
 Which formats a user can choose, and which reports each renders, is the registry of
 :mod:`ar3cli.output.formats`; every format ends here, writing the Report it made as text or JSON.
 """
@@ -256,23 +258,41 @@ def _wrap(text: str, size: int) -> list[str]:
 
 def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room: int) -> list[int] | None:
     """Column widths that fit ``room`` characters of cells: the long text columns capped at one
-    common width (the widest shrink first), the others whole; None when that cap is too small."""
+    common width (the widest shrink first), never below their longest word (up to
+    :data:`LONGEST_WORD`: a joint name is not split) nor :data:`MIN_WRAPPED_WIDTH`; the others
+    whole, their headers wrapped when that is still too wide. None when even that does not fit."""
     if sum(natural) <= room:
         return natural
     flexible = [index for index, column in enumerate(table.columns)
                 if column not in table.nowrap_columns and column not in table.numeric_columns
                 and column != table.status_column and natural[index] > 16]
-    left = room - sum(size for index, size in enumerate(natural) if index not in flexible)
-    count = len(flexible)
-    for size in sorted(natural[index] for index in flexible):
-        if size * count > left:
-            break
-        left -= size
-        count -= 1
-    if not count or left // count < MIN_WRAPPED_WIDTH:
+    floors = {index: min(natural[index], max(MIN_WRAPPED_WIDTH, min(LONGEST_WORD, max(
+        len(word) for text in [table.columns[index], *(row[index] for row in rows)] for word in [*text.split(), ""]))))
+        for index in flexible}
+    whole = list(natural)
+    if sum(natural[index] if index not in flexible else floors[index] for index in range(len(natural))) > room:
+        # still too wide: the headers of the other columns may wrap too ("declared effort" over "20 N m")
+        whole = [max([len(row[index]) for row in rows] + [len(word) for word in column.split()])
+                 if index not in flexible else size for index, (column, size) in enumerate(zip(table.columns, natural))]
+    fixed = sum(size for index, size in enumerate(whole) if index not in flexible)
+
+    def width(cap: int, index: int) -> int:
+        return max(floors[index], min(natural[index], cap))
+
+    def total(cap: int) -> int:
+        return fixed + sum(width(cap, index) for index in flexible)
+
+    if total(0) > room:
         return None
-    cap = left // count
-    return [min(size, cap) if index in flexible else size for index, size in enumerate(natural)]
+    low, high = 0, max((natural[index] for index in flexible), default=0)
+    while low < high:  # the largest common cap that fits
+        middle = (low + high + 1) // 2
+        low, high = (middle, high) if total(middle) <= room else (low, middle - 1)
+    return [width(low, index) if index in flexible else size for index, size in enumerate(whole)]
+
+
+LONGEST_WORD = 30
+"""A word up to this long keeps its column wide enough to stay whole; longer ones (paths) may break."""
 
 
 def plain_blocks(table: Table, rows: list[list[str]], width: int) -> str:
