@@ -220,13 +220,17 @@ def plain_table(table: Table, width: int | None = None) -> str:
 
     Fitting keeps the short columns whole (location, code, severity, numbers: what grep looks for,
     on each row's first line) and wraps the long ones (message, hint) inside their cells; when the
-    long ones would get fewer than :data:`MIN_WRAPPED_WIDTH` columns, each row is a block instead
-    (:func:`plain_blocks`). Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's
-    659 lint findings); this plain formatter is what pipes, CI logs and ``--wide`` get.
+    table cannot fit without splitting words and numbers, each row is a block instead
+    (:func:`plain_blocks`: the short cells on one line, the long ones below), or, when every column
+    is short (a block would only drop the header), one line per row as it is. Rich's layout engine
+    takes ~0.6 ms per row (0.4 s for pybullet_data's 659 lint findings); this plain formatter is
+    what pipes, CI logs and ``--wide`` get.
     """
-    rows = [[format_cell(value).replace("\n", " ") for value in row] for row in table.rows]
+    rows = [[format_cell(value) for value in row] for row in table.rows]
     natural = [max([len(column), *(len(row[index]) for row in rows)]) for index, column in enumerate(table.columns)]
     widths = natural if width is None else _fitted_widths(table, natural, rows, width - 3 * len(natural) - 1)
+    if widths is None and len(_short_columns(table, rows)) == len(table.columns):
+        widths = natural
     if widths is None:
         return plain_blocks(table, rows, width or 80)
     numeric = [column in table.numeric_columns for column in table.columns]
@@ -266,9 +270,15 @@ def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room
     flexible = [index for index, column in enumerate(table.columns)
                 if column not in table.nowrap_columns and column not in table.numeric_columns
                 and column != table.status_column and natural[index] > 16]
-    floors = {index: min(natural[index], max(MIN_WRAPPED_WIDTH, min(LONGEST_WORD, max(
+    words = {index: min(natural[index], max(MIN_WRAPPED_WIDTH, min(LONGEST_WORD, max(
         len(word) for text in [table.columns[index], *(row[index] for row in rows)] for word in [*text.split(), ""]))))
         for index in flexible}
+    return _capped_widths(table, natural, rows, room, flexible, words)
+
+
+def _capped_widths(table: Table, natural: list[int], rows: list[list[str]], room: int, flexible: list[int],
+                   floors: dict[int, int]) -> list[int] | None:
+    """:func:`_fitted_widths` for the ``flexible`` columns' smallest widths ``floors``."""
     whole = list(natural)
     if sum(natural[index] if index not in flexible else floors[index] for index in range(len(natural))) > room:
         # still too wide: the headers of the other columns may wrap too ("declared effort" over "20 N m")
