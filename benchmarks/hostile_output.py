@@ -13,7 +13,7 @@ the same rounds, alternating; every process may map at most ``--memory-limit`` M
 Usage (inside the project's venv)::
 
     python benchmarks/hostile_output.py --case orphans                      # this checkout, 5 runs
-    python benchmarks/hostile_output.py --case orphans --before /path/to/old/checkout --runs 3
+    python benchmarks/hostile_output.py --case orphans --before /path/to/old/checkout --before-runs 1
     python benchmarks/hostile_output.py --case orphans --links 5000 --formats github
 """
 
@@ -102,40 +102,49 @@ def main() -> None:
     parser.add_argument("--case", choices=CASES, default="orphans")
     parser.add_argument("--links", type=int, nargs="+", default=[5000, 20000])
     parser.add_argument("--formats", nargs="+", default=["github", "text"])
-    parser.add_argument("--runs", type=int, default=5, help="timed runs per variant (after one warm-up of each)")
+    parser.add_argument("--runs", type=int, default=5, help="timed runs of this checkout (after one warm-up)")
     parser.add_argument("--before", type=Path, help="a second source tree to time in the same rounds (an older checkout)")
+    parser.add_argument("--before-runs", type=int, help="timed runs of --before (default: --runs); an old tree "
+                                                        "may take minutes a run")
     parser.add_argument("--memory-limit", type=int, default=4096, help="MB a process may map (RLIMIT_AS)")
     parser.add_argument("--timeout", type=float, default=600, help="seconds a process may run")
     args = parser.parse_args()
-    sources = [("this checkout", _timing.REPO)] + ([("before", args.before.resolve())] if args.before else [])
+    sources = [("this checkout", _timing.REPO, args.runs)]
+    if args.before:
+        sources.append(("before", args.before.resolve(), args.runs if args.before_runs is None else args.before_runs))
     print(_timing.machine_header(f"hostile_output.py --case {args.case}"))
-    rows = []
+    print(f"- ar3cli run as `python -m ar3cli lint-urdf --no-cache --format FMT FILE` with PYTHONPATH = the source "
+          f"tree; runs: {', '.join(f'{name} {runs}' for name, _, runs in sources)} after one warm-up each, "
+          "alternating; medians")
+    print("- robot file sizes: " + ", ".join(f"{links:,} links {len(orphans(links)) / 1e3:.0f} KB" for links in args.links))
+    print()
+    print("| source | case | links | format | runs | wall s | peak memory MB | output KB | exit |")
+    print("|---|---|---:|---|---:|---:|---:|---:|---|", flush=True)
     for links in args.links:
         robot = _timing.WORK / f"{args.case}-{links}.urdf"
         robot.write_text(orphans(links))
         for fmt in args.formats:
-            variants = [Row(name, args.case, links, fmt) for name, _ in sources]
+            variants = [Row(name, args.case, links, fmt) for name, _, _ in sources]
             print(f"  measuring: {links:,} {args.case}, --format {fmt}", file=sys.stderr, flush=True)
-            for round_ in range(args.runs + 1):  # the first round warms up (bytecode, file cache)
-                for row, (_, source) in zip(variants, sources):
-                    if row.samples and row.samples[-1].stopped:
-                        continue  # stopped at a limit once: the next run would too
+            for round_ in range(max(runs for _, _, runs in sources) + 1):  # the first round warms up
+                for row, (_, source, runs) in zip(variants, sources):
+                    if round_ > runs or (row.samples and row.samples[-1].stopped):
+                        continue  # enough runs, or stopped at a limit once: the next run would be too
                     sample = run(source, robot, fmt, args.memory_limit, args.timeout)
                     if round_ or sample.stopped:
                         row.samples.append(sample)
-            rows += variants
-    print(f"{args.runs} runs each after a warm-up, alternating; medians; robot file sizes: "
-          + ", ".join(f"{links:,} links {len(orphans(links)) / 1e3:.0f} KB" for links in args.links) + "\n")
-    print("| source | case | links | format | wall s | peak memory MB | output KB | exit |")
-    print("|---|---|---:|---|---:|---:|---:|---|")
-    for row in rows:
-        stopped = next((s.stopped for s in row.samples if s.stopped), "")
-        fine = [s for s in row.samples if not s.stopped] or row.samples
-        print(f"| {row.source} | {row.case} | {row.links:,} | {row.fmt} | "
-              f"{statistics.median(s.wall for s in fine):.2f} | {statistics.median(s.max_rss_mb for s in fine):,.0f} | "
-              f"{statistics.median(s.output_mb for s in fine) * 1000:,.1f} | {stopped or fine[0].code} |")
+            for row in variants:
+                print(_line(row), flush=True)
     print()
     print(_timing.machine_footer())
+
+
+def _line(row: Row) -> str:
+    stopped = next((s.stopped for s in row.samples if s.stopped), "")
+    fine = [s for s in row.samples if not s.stopped] or row.samples
+    return (f"| {row.source} | {row.case} | {row.links:,} | {row.fmt} | {len(fine)} | "
+            f"{statistics.median(s.wall for s in fine):.2f} | {statistics.median(s.max_rss_mb for s in fine):,.0f} | "
+            f"{statistics.median(s.output_mb for s in fine) * 1000:,.1f} | {stopped or fine[0].code} |")
 
 
 if __name__ == "__main__":
