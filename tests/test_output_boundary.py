@@ -395,6 +395,8 @@ def test_thousands_of_orphan_links_make_linear_output(cli, tmp_path):
     assert summary.stat().st_size < 10_000 and "and 1,979 more" in summary.read_text()  # 20 in the details
     text = cli("lint-urdf", "orphans.urdf", cwd=tmp_path).stdout  # piped: one line for the alike findings
     assert len(text.splitlines()) == 2 and "1999x: link 'orphan_1' is not connected" in text
+    every = cli("lint-urdf", "orphans.urdf", "--no-group", cwd=tmp_path).stdout.splitlines()
+    assert len(every) == 1002 and every[-2] == "orphans.urdf: (and 999 more rows: --format json lists them all)"
 
 
 def test_tables_and_trees_show_at_most_a_thousand_rows():

@@ -8,6 +8,7 @@ import sys
 from ar3cli.findings import Finding
 from ar3cli.output.formats import LINT, REPORT, Format, register
 from ar3cli.output.lint_report import LintReport, completed, summary_line
+from ar3cli.output.lists import capped, left_out
 from ar3cli.output.report import Report, Table, piped
 
 
@@ -32,8 +33,11 @@ def lint_text(lint: LintReport) -> Report:
 
 def concise_lines(findings: list[Finding], lint: LintReport) -> list[str]:
     """``path:line:col: CODE [severity] message``, a line per finding or group of alike findings (as
-    ruff's concise output; editors and terminals make the location a link, grep finds the code)."""
-    return [f"{location}: {code} [{severity}] {message}" for location, code, severity, message, _ in _rows(findings, lint)]
+    ruff's concise output; editors and terminals make the location a link, grep finds the code), at
+    most :data:`~ar3cli.output.lists.TABLE_ROWS` a file, as its table."""
+    rows, left = capped(_rows(findings, lint))
+    lines = [f"{location}: {code} [{severity}] {message}" for location, code, severity, message, _ in rows]
+    return lines + ([f"{findings[0].path}: {left_out(left)}"] if left else [])
 
 
 def _rows(findings: list[Finding], lint: LintReport) -> list[list]:
