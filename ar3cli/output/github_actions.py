@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 
-from ar3cli.findings import Finding, Severity
+from ar3cli.findings import Severity
 from ar3cli.output.escape import github_data, github_property
 
 COMMANDS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "notice"}
@@ -43,13 +43,6 @@ def workflow_command(kind: str, message: str | Sequence[str], *, file: str = "",
         properties.append(f"title={github_property(title)}")
     text = github_data(message) if isinstance(message, str) else "%0A".join(map(github_data, message))
     return f"::{kind}{' ' + ','.join(properties) if properties else ''}::{text}"
-
-
-def annotation(finding: Finding) -> str:
-    """``::error file=PATH,line=L,col=C,title=CODE::message (fix: hint)``."""
-    message = finding.message + (f" (fix: {finding.hint})" if finding.hint else "")
-    return workflow_command(COMMANDS[finding.severity], message, file=finding.path, line=finding.line,
-                            column=max(finding.column, 1), title=finding.rule)
 
 
 def capped_annotations(lines: list[str], what: str = "findings") -> str:
