@@ -149,7 +149,7 @@ def arguments(root: Path) -> dict[str, list[list[str]]]:
         "cross-check": [[one, "-n", "1"]],
         "diff": [[one, os.fsdecode(moved.relative_to(root)), "-n", "2"]],
         "scan": [[folder, "--store", "scanned.sqlite"]],
-        "scan-report": [["store.sqlite", "--keep", "loads"]],
+        "scan-report": [["store.sqlite", "--keep", "loads", "--keep-list", "keep.txt"]],
         "report": [[one, "-o", "page.html", "-n", "2"]],
     }
     for command in COMMANDS:
@@ -212,7 +212,7 @@ def finished(workspace) -> list[Run]:
         shutil.copytree(workspace, folder, ignore=shutil.ignore_patterns("run-*"), symlinks=True)
         done = _cli(run.args, folder, run.env)
         run.code, run.stdout, run.stderr = done.returncode, done.stdout, done.stderr
-        for name in ("page.html",):
+        for name in ("page.html", "keep.txt"):
             if (folder / name).exists():
                 run.files[name] = (folder / name).read_bytes()
         if "GITHUB_STEP_SUMMARY" in run.env and Path(run.env["GITHUB_STEP_SUMMARY"]).exists():
@@ -317,6 +317,16 @@ def test_html_pages_escape_every_name(finished):
         assert len(scripts) <= 2 and not [attrs for tag, attrs in parsed.tags if tag in ("img", "a")
                                           and "evil" in " ".join(str(v) for v in attrs.values())], run.args
         assert "<script>alert(1)" in "".join(parsed.text), run.args
+
+
+def test_a_keep_list_holds_one_real_path_a_line(finished):
+    """A file name with a newline would write a second, forged path into scan-report's keep-list."""
+    for run in finished:
+        if "keep.txt" in run.files:
+            paths = run.files["keep.txt"].decode("utf-8", "surrogateescape").splitlines()
+            assert [Path(path).name for path in paths] == ["other.urdf"]
+            if run.fmt != "json":
+                assert "left out 1 whose name holds a line break" in _text(run.stdout + run.stderr), run.args
 
 
 def test_junit_sarif_and_json_are_well_formed(finished):

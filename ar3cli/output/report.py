@@ -270,15 +270,9 @@ def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room
     flexible = [index for index, column in enumerate(table.columns)
                 if column not in table.nowrap_columns and column not in table.numeric_columns
                 and column != table.status_column and natural[index] > 16]
-    words = {index: min(natural[index], max(MIN_WRAPPED_WIDTH, min(LONGEST_WORD, max(
+    floors = {index: min(natural[index], max(MIN_WRAPPED_WIDTH, min(LONGEST_WORD, max(
         len(word) for text in [table.columns[index], *(row[index] for row in rows)] for word in [*text.split(), ""]))))
         for index in flexible}
-    return _capped_widths(table, natural, rows, room, flexible, words)
-
-
-def _capped_widths(table: Table, natural: list[int], rows: list[list[str]], room: int, flexible: list[int],
-                   floors: dict[int, int]) -> list[int] | None:
-    """:func:`_fitted_widths` for the ``flexible`` columns' smallest widths ``floors``."""
     whole = list(natural)
     if sum(natural[index] if index not in flexible else floors[index] for index in range(len(natural))) > room:
         # still too wide: the headers of the other columns may wrap too ("declared effort" over "20 N m")
