@@ -84,3 +84,22 @@ def test_json_keeps_every_finding_and_ci_formats_group_by_rule_and_file(cli, wri
     assert cli("lint-urdf", path, "--group", "--format", "markdown").stdout.count("| J001 |") == 1
     every = cli("lint-urdf", path, "--no-group", "--format", "github").stdout
     assert every.count("title=J001") == 4
+    import xml.etree.ElementTree as ET
+
+    (case,) = ET.fromstring(cli("lint-urdf", path, "--format", "junit").stdout).iter("testcase")
+    failure = case.find("failure")
+    assert failure.get("message").endswith("(4 findings)") and failure.text.count(" error J001: ") == 4
+
+
+def test_ci_groups_are_one_per_rule_and_file_errors_first_and_long_messages_cut():
+    from ar3cli.output.lint_report import headline, rule_groups
+
+    findings = [finding("I002", "link 'x' is a frame", 3, severity=Severity.WARNING),
+                finding("G001", "link 'a' mesh m.stl: not found; looked in " + ", ".join(["/far/away"] * 40), 5),
+                finding("G001", "link 'b' mesh n.stl: not found", 9), finding("G001", "elsewhere", 2, "b.urdf")]
+    groups = rule_groups(findings)
+    assert [(group.first.rule, group.first.path, group.count) for group in groups] == [
+        ("G001", "a.urdf", 2), ("G001", "b.urdf", 1), ("I002", "a.urdf", 1)]
+    assert groups[0].summary() == "2x: link 'a' mesh m.stl: not found; ... (and 1 more like it)"
+    assert groups[0].places() == "5:3, 9:3" and headline("short") == "short"
+    assert [group.count for group in rule_groups(findings, grouped=False)] == [1, 1, 1, 1]

@@ -215,22 +215,21 @@ MIN_WRAPPED_WIDTH = 12
 """A wrapped column narrower than this reads as a word list: the table is printed as blocks."""
 
 
-def plain_table(table: Table, width: int | None = None) -> str:
+def plain_table(table: Table, width: int | None = None, blocks: bool = True) -> str:
     """An ASCII table: one line per row when ``width`` is None, else fitted into ``width`` columns.
 
     Fitting keeps the short columns whole (location, code, severity, numbers: what grep looks for,
     on each row's first line) and wraps the long ones (message, hint) inside their cells; when the
     table cannot fit without splitting words and numbers, each row is a block instead
-    (:func:`plain_blocks`: the short cells on one line, the long ones below), or, when every column
-    is short (a block would only drop the header), one line per row as it is. Rich's layout engine
-    takes ~0.6 ms per row (0.4 s for pybullet_data's 659 lint findings); this plain formatter is
-    what pipes, CI logs and ``--wide`` get.
+    (:func:`plain_blocks`: the short cells on one line, the long ones below), or, with ``blocks``
+    False (a pipe's default width, which is no reader's limit), the table as narrow as it goes
+    without splitting them. Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's
+    659 lint findings); this plain formatter is what pipes, CI logs and ``--wide`` get.
     """
     rows = [[format_cell(value) for value in row] for row in table.rows]
     natural = [max([len(column), *(len(row[index]) for row in rows)]) for index, column in enumerate(table.columns)]
-    widths = natural if width is None else _fitted_widths(table, natural, rows, width - 3 * len(natural) - 1)
-    if widths is None and len(_short_columns(table, rows)) == len(table.columns):
-        widths = natural
+    room = None if width is None else width - 3 * len(natural) - 1
+    widths = natural if room is None else _fitted_widths(table, natural, rows, room, narrowest=not blocks)
     if widths is None:
         return plain_blocks(table, rows, width or 80)
     numeric = [column in table.numeric_columns for column in table.columns]
@@ -254,17 +253,25 @@ def plain_table(table: Table, width: int | None = None) -> str:
     return "\n".join(out) + "\n"
 
 
+def piped_table(table: Table, stream: TextIO, wide: bool = False) -> str:
+    """:func:`plain_table` as ``stream`` takes it off a terminal: the width of :func:`table_width`;
+    blocks only for a width someone chose (``COLUMNS``), not for a pipe's default."""
+    return plain_table(table, table_width(stream, wide), blocks=not piped(stream))
+
+
 def _wrap(text: str, size: int) -> list[str]:
     import textwrap
 
     return textwrap.wrap(text, size, break_on_hyphens=False) or [""]
 
 
-def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room: int) -> list[int] | None:
+def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room: int,
+                   narrowest: bool = False) -> list[int] | None:
     """Column widths that fit ``room`` characters of cells: the long text columns capped at one
     common width (the widest shrink first), never below their longest word (up to
     :data:`LONGEST_WORD`: a joint name is not split) nor :data:`MIN_WRAPPED_WIDTH`; the others
-    whole, their headers wrapped when that is still too wide. None when even that does not fit."""
+    whole, their headers wrapped when that is still too wide. None when even that does not fit,
+    or with ``narrowest`` those smallest widths."""
     if sum(natural) <= room:
         return natural
     flexible = [index for index, column in enumerate(table.columns)
@@ -287,7 +294,7 @@ def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room
         return fixed + sum(width(cap, index) for index in flexible)
 
     if total(0) > room:
-        return None
+        return [width(0, index) if index in flexible else size for index, size in enumerate(whole)] if narrowest else None
     low, high = 0, max((natural[index] for index in flexible), default=0)
     while low < high:  # the largest common cap that fits
         middle = (low + high + 1) // 2
@@ -362,7 +369,7 @@ def render_table(table: Table, out=None, wide: bool = False) -> None:
     out = out or console()
     table = bounded(table)
     if wide or not out.is_terminal:
-        out.file.write(plain_table(table, table_width(out.file, wide)))
+        out.file.write(piped_table(table, out.file, wide))
         out.file.flush()
         return
     if out.width < NARROW_TERMINAL and len(table.columns) > 3:
@@ -440,8 +447,7 @@ def render_report(report: Report, fmt: OutputFormat | str) -> None:
     if trees and (report.wide or not stream.isatty()):
         # What render_table would print off a terminal, without creating a console: importing rich
         # costs ~25 ms of every piped run.
-        width = table_width(stream, report.wide)
-        write(stream, "".join([*(plain_table(bounded(table), width) for table in report.tables),
+        write(stream, "".join([*(piped_table(bounded(table), stream, report.wide) for table in report.tables),
                                *("\n" + plain_tree(tree) for tree in report.renderables),
                                "\n" if report.renderables else "",
                                *(printable(line) + "\n" for line in report.lines)]))
