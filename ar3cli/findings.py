@@ -1,8 +1,10 @@
-"""Findings: plain data that every checker produces and the output layer renders."""
+"""Findings: plain data that every checker produces and the output layer renders, and :func:`listed`,
+the one way a message lists names."""
 
 from __future__ import annotations
 
 import enum
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 
@@ -68,3 +70,22 @@ class Finding:
         if self.line:
             return f"{self.path}:{self.line}:{self.column or 1}"
         return self.path
+
+
+LIST_ITEMS = 10
+"""Items a message names at most, then "and N more"."""
+
+
+def listed(items: Iterable[object], most: int = LIST_ITEMS, separator: str = ", ") -> str:
+    """``a, b, c``, or the first ``most`` items and ``and N more``: how every message (a finding, an
+    error, a note) lists names. A robot file decides how many links it has, so a message naming all
+    of them grows with the file, and one such message per link with its square: S005 once listed all
+    5,000 roots of a file in each of its 4,999 findings (170 MB of GitHub annotations)."""
+    shown: list[str] = []
+    left = 0
+    for item in items:
+        if len(shown) < most:
+            shown.append(str(item))
+        else:
+            left += 1
+    return separator.join(shown) + (f" and {left:,} more" if left else "")

@@ -233,18 +233,19 @@ def test_broken_file_fails_with_annotations_summary_outputs_and_sarif(robots, tm
     assert run.failed
     assert run.outputs["exit-code"] == "1" and run.outputs["failed"] == "true"
     errors = [line for line in run.stdout.splitlines() if line.startswith("::error ")]
-    assert len(errors) == 3 and all("file=robots/broken.urdf" in line and "title=I001" in line for line in errors)
+    (error,) = errors  # three I001 findings in one file: one annotation with the count
+    assert "file=robots/broken.urdf,line=152" in error and "title=I001 (3 in this file)::3x: " in error
     assert "good.urdf" not in run.stdout
     assert "## ar3cli lint-urdf" in run.summary
     assert "| location | rule | severity | message | hint |" in run.summary
-    assert "`robots/broken.urdf:152:3` | I001 | error" in run.summary
+    assert "`robots/broken.urdf:152:3` | I001 | error | 3x: " in run.summary and "<details>" in run.summary
     # the SARIF step runs even though the lint step failed
     assert run.steps["sarif"]["outcome"] == "success", run.stderr
     assert run.outputs["sarif-file"] == "results/ar3cli.sarif"
     sarif = json.loads((robots / "results" / "ar3cli.sarif").read_text(encoding="utf-8"))
     assert sarif["version"] == "2.1.0"
-    assert {result["ruleId"] for result in sarif["runs"][0]["results"]} == {"I001"}
-    assert len(sarif["runs"][0]["results"]) == 3
+    (result,) = sarif["runs"][0]["results"]  # one result per rule and file, the others its related locations
+    assert result["ruleId"] == "I001" and len(result["relatedLocations"]) == 2
     assert run.steps["upload-sarif"]["outcome"] == "skipped"
 
 
@@ -262,7 +263,7 @@ def test_args_exit_zero_keeps_annotations_but_passes(robots, tmp_path):
     run = run_action(robots, tmp_path, paths="robots", args="--exit-zero")
     assert not run.failed, run.stderr
     assert run.outputs["exit-code"] == "0" and run.outputs["failed"] == "false"
-    assert run.stdout.count("::error file=robots/broken.urdf") == 3
+    assert run.stdout.count("::error file=robots/broken.urdf") == 1 and "(3 in this file)" in run.stdout
 
 
 def test_args_ignore_and_several_paths(robots, tmp_path):

@@ -50,7 +50,7 @@ def test_a_long_chain_with_a_cycle_at_its_end_reports_the_cycle_once(tmp_path):
     path.write_text(_robot(3000, extra=cycle))  # the root hangs from the last link: one 3,000-link loop
     (finding,) = _lint(path, ["S006"]).findings
     assert finding.message.startswith("joints form a cycle through links l1 -> l0 -> l2999 -> l2998")
-    assert finding.message.count(" -> ") == 3000
+    assert finding.message.endswith("-> l2992 and 2,991 more")  # a message names 10 links, then counts the rest
 
 
 def test_inline_ignores_are_gathered_once_per_tree(tmp_path, monkeypatch):

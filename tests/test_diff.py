@@ -389,7 +389,7 @@ def test_nan_never_reaches_the_output_and_a_floating_joint_is_a_note(tmp_path):
     old = write(tmp_path, "old.urdf", ARM)
     nan = write(tmp_path, "nan.urdf", ARM.replace('xyz="0 0 0.3"', 'xyz="nan 0 0.3"').replace(
         '<mass value="0.5"/>', '<mass value="nan"/>'))
-    text = run_cli("diff", str(old), str(nan), "-n", "3")
+    text = run_cli("diff", str(old), str(nan), "-n", "3", env={"COLUMNS": "1000"})  # a row a line: no wrapped message
     assert text.code == 1 and "| nan " not in text.stdout.replace("nan.urdf", "")
     document = diff_json(str(old), str(nan), code=1)  # json.loads refuses nothing: NaN would be written as NaN
     assert "NaN" not in json.dumps(document)

@@ -115,7 +115,8 @@ def test_limits_from_moveit_yaml_on_the_real_ar3(cli, real_ar3):
     limits_file = real / "extra" / "ar3_moveit_config" / "config" / "joint_limits.yaml"
     package = f"ar3_description={real}"
     original = path.read_text()
-    refused = cli("fix-continuous", str(path), "--limits-from", str(limits_file), "--package-path", package)
+    refused = cli("fix-continuous", str(path), "--limits-from", str(limits_file), "--package-path", package,
+                  env={"COLUMNS": "1000"})  # the table a row a line: the reason whole
     assert refused.code == 1 and "pass --effort" in refused.stdout and path.read_text() == original
     result = cli("fix-continuous", str(path), "--limits-from", str(limits_file), "--effort", "10",
                  "--package-path", package, "--format", "json")

@@ -124,7 +124,7 @@ def test_watertight_pybullet_mesh_matches_trimesh(cli, write_urdf, pybullet_data
 def test_no_mass_source_is_reported_and_left_alone(cli, write_urdf):
     path = write_urdf(TEXTBOOK)
     before = path.read_bytes()
-    result = cli("fix-inertia", str(path), "--links", "box")
+    result = cli("fix-inertia", str(path), "--links", "box", env={"COLUMNS": "1000"})  # a row a line
     assert result.code == 1
     assert "no valid mass in the file: give --density, --mass box=KG or --total-mass" in result.stdout
     assert path.read_bytes() == before

@@ -69,10 +69,13 @@ def test_github_annotations_escape_properties_and_data(cli, write_urdf):
 
 
 def test_github_escape_functions():
-    from ar3cli.output.github_actions import escape_data, escape_property
+    from ar3cli.output.escape import github_data, github_property
+    from ar3cli.output.github_actions import workflow_command
 
-    assert escape_data("50%\r\nnext") == "50%25%0D%0Anext"
-    assert escape_property("a:b,c%") == "a%3Ab%2Cc%25"
+    assert github_data("50%") == "50%25"
+    assert github_data("a\r\nb") == "a\\x0d\\x0ab"  # a name's newline is shown, never a line of its own
+    assert github_property("a:b,c%") == "a%3Ab%2Cc%25"
+    assert workflow_command("notice", ["one", "two"], title="t") == "::notice title=t::one%0Atwo"  # ar3cli's own lines
 
 
 def test_markdown_table(cli, write_urdf):
@@ -97,7 +100,7 @@ def test_github_format_writes_step_summary(cli, tmp_path):
 def test_unwritable_step_summary_is_one_error_after_the_annotations(cli, tmp_path):
     example = str(ASSETS / "examples" / "ar3_no_inertia.urdf")
     result = cli("lint-urdf", example, "--format", "github", env={"GITHUB_STEP_SUMMARY": str(tmp_path)})  # a folder
-    assert result.code == 2 and result.stdout.count("::error file=") == 3
+    assert result.code == 2 and result.stdout.count("::error file=") == 1  # three I001 in one file: one annotation
     assert result.stderr.startswith("ar3cli: error: cannot append to $GITHUB_STEP_SUMMARY") and "Traceback" not in result.stderr
     assert cli("lint-urdf", example, "--format", "github", env={"GITHUB_STEP_SUMMARY": ""}).code == 1
 

@@ -1,5 +1,7 @@
-"""Grouping in lint-urdf's text table: 3 or more alike findings of one rule in one file become one
-row (count, first locations, the first message); --group/--no-group; other formats keep every finding."""
+"""Grouping in lint-urdf's text output: 5 or more alike findings of one rule in one file become one
+row or line (count, first locations, the first message); --group/--no-group; JSON keeps every
+finding, the CI formats (github, markdown, sarif, junit) show one annotation, row, result or test
+case per rule and file (issue 36, item 2)."""
 
 from __future__ import annotations
 
@@ -62,19 +64,42 @@ def test_cli_group_and_no_group(cli, write_urdf):
     path = str(write_urdf(chain(5)))
     grouped = cli("lint-urdf", path, "--group", "--no-cache")
     assert grouped.code == 1
-    rows = [line for line in grouped.stdout.splitlines() if "| J001 |" in line]
+    rows = [line for line in grouped.stdout.splitlines() if " J001 [error] " in line]  # piped: a line per row
     assert len(rows) == 1 and "5x: revolute joint 'j0' has no <limit> (and 4 more like it); at " in rows[0]
     assert "FAILED: 1 file checked, 5 errors" in grouped.stdout  # the summary counts every finding
     every = cli("lint-urdf", path, "--no-group")
-    assert every.stdout.count("| J001 |") == 5
+    assert every.stdout.count(" J001 [error] ") == 5
+    assert cli("lint-urdf", path, "--no-group", "--wide").stdout.count("| J001 |") == 5
     assert cli("lint-urdf", path, "--no-cache").stdout == grouped.stdout  # grouped by default, terminal or not
 
 
-def test_other_formats_keep_every_finding(cli, write_urdf):
+def test_json_keeps_every_finding_and_ci_formats_group_by_rule_and_file(cli, write_urdf):
     path = str(write_urdf(chain(4)))
     document = json.loads(cli("lint-urdf", path, "--group", "--format", "json").stdout)
     assert len(document["findings"]) == 4 and document["summary"]["findings"] == 4
     sarif = json.loads(cli("lint-urdf", path, "--group", "--format", "sarif").stdout)
-    assert len(sarif["runs"][0]["results"]) == 4
-    assert cli("lint-urdf", path, "--group", "--format", "github").stdout.count("title=J001") == 4
-    assert cli("lint-urdf", path, "--group", "--format", "markdown").stdout.count("| J001 |") == 4
+    (result,) = sarif["runs"][0]["results"]
+    assert len(result["relatedLocations"]) == 3 and "4 findings of J001" in result["message"]["text"]
+    assert cli("lint-urdf", path, "--group", "--format", "github").stdout.count("title=J001") == 1
+    assert cli("lint-urdf", path, "--group", "--format", "markdown").stdout.count("| J001 |") == 1
+    every = cli("lint-urdf", path, "--no-group", "--format", "github").stdout
+    assert every.count("title=J001") == 4
+    import xml.etree.ElementTree as ET
+
+    (case,) = ET.fromstring(cli("lint-urdf", path, "--format", "junit").stdout).iter("testcase")
+    failure = case.find("failure")
+    assert failure.get("message").endswith("(4 findings)") and failure.text.count(" error J001: ") == 4
+
+
+def test_ci_groups_are_one_per_rule_and_file_errors_first_and_long_messages_cut():
+    from ar3cli.output.lint_report import headline, rule_groups
+
+    findings = [finding("I002", "link 'x' is a frame", 3, severity=Severity.WARNING),
+                finding("G001", "link 'a' mesh m.stl: not found; looked in " + ", ".join(["/far/away"] * 40), 5),
+                finding("G001", "link 'b' mesh n.stl: not found", 9), finding("G001", "elsewhere", 2, "b.urdf")]
+    groups = rule_groups(findings)
+    assert [(group.first.rule, group.first.path, group.count) for group in groups] == [
+        ("G001", "a.urdf", 2), ("G001", "b.urdf", 1), ("I002", "a.urdf", 1)]
+    assert groups[0].summary() == "2x: link 'a' mesh m.stl: not found; ... (and 1 more like it)"
+    assert groups[0].places() == "5:3, 9:3" and headline("short") == "short"
+    assert [group.count for group in rule_groups(findings, grouped=False)] == [1, 1, 1, 1]

@@ -65,7 +65,7 @@ def test_paths_follow_how_the_top_file_was_named(cli, tmp_path):
     assert from_below == {"../arm.urdf.xacro", "../macros/arm_segment.xacro"}
     text = cli("lint-urdf", "--no-cache", "xacro/arm.urdf.xacro", cwd=tmp_path).stdout
     tool_line = _line_of(MACROS, '<link name="tool0"/>')
-    assert f"| xacro/macros/arm_segment.xacro:{tool_line}:5 " in text
+    assert f"\nxacro/macros/arm_segment.xacro:{tool_line}:5: " in text  # piped: path:line:col: CODE, a line each
 
 
 def test_per_file_ignores_apply_to_the_included_file(cli, tmp_path):

@@ -5,6 +5,7 @@ one failure per testcase (issues 22 and 30)."""
 from __future__ import annotations
 
 import json
+import re
 import xml.etree.ElementTree as ET
 
 import pytest
@@ -78,7 +79,8 @@ def test_densities_that_are_no_material_are_refused(cli, write_urdf):
 
 def test_printable_shows_controls_and_bidi_marks_and_keeps_the_rest():
     assert printable("plain ümlaut 日本") == "plain ümlaut 日本"
-    assert printable("a\x1b[2Jb\rc\x9bd\u202ee\x7f\tf\ng") == "a\\x1b[2Jb\\x0dc\\x9bd\\u202ee\\x7f\tf\ng"
+    assert printable("a\x1b[2Jb\rc\x9bd\u202ee\x7f\tf\ng") == "a\\x1b[2Jb\\x0dc\\x9bd\\u202ee\\x7f\tf\\x0ag"
+    assert printable("bad\udcff\u2028") == "bad\\xff\\u2028"  # a file name's non-UTF-8 byte, a line separator
 
 
 def test_control_characters_are_neutralised_in_text_github_markdown_and_kept_in_json(cli, tmp_path):
@@ -130,7 +132,10 @@ def test_lint_text_honours_columns_and_wide(cli, tmp_path):
     rows = [line for line in wide.stdout.splitlines() if line.startswith("| bad.urdf:")]
     assert len(rows) == 2 and max(map(len, rows)) > 80  # one line per finding, however wide
     piped = cli("lint-urdf", "bad.urdf", "--no-cache", cwd=tmp_path, env={"COLUMNS": ""})
-    assert [line for line in piped.stdout.splitlines() if line.startswith("| bad.urdf:")] == rows
+    concise = piped.stdout.splitlines()  # piped without COLUMNS: a line per finding, as ruff's concise output
+    assert [line for line in concise if line.startswith("bad.urdf:")] == [
+        line for line in concise if re.fullmatch(r"bad\.urdf:\d+:\d+: [A-Z]\d{3} \[(error|warning|info)\] .+", line)]
+    assert len([line for line in concise if line.startswith("bad.urdf:")]) == 2 and concise[-1].startswith("FAILED")
 
 
 # ---- 4. the lint summary agrees with itself and with the exit code -------------------------------------
@@ -146,6 +151,29 @@ def test_summary_fields_agree_with_the_counts_and_the_exit_code(cli, tmp_path):
     assert summary["exit_code"] == result.code == 1
     zero = cli("lint-urdf", ".", "--no-cache", "--format", "json", "--exit-zero", cwd=tmp_path)
     assert json.loads(zero.stdout)["summary"]["exit_code"] == zero.code == 0
+
+
+INFO_AND_WARNING = '<robot name="r"><link name="base"><visual><geometry><box size="1 1 1"/></geometry></visual></link></robot>'
+"""G008 (warning) and I012 (info), nothing at or above the default --fail-on."""
+
+
+def test_clean_means_nothing_at_or_above_fail_on_in_the_summary_json_and_scan(cli, tmp_path):
+    """Issue 36 item 4: lint --sim's P003 (info) on the bundled AR3 made the summary say "1 info; 0 clean"
+    and scan-report --keep clean keep nothing."""
+    (tmp_path / "bad.urdf").write_text(TWO_ERRORS)
+    (tmp_path / "info.urdf").write_text(INFO_AND_WARNING)
+    text = cli("lint-urdf", ".", "--no-cache", cwd=tmp_path).stdout
+    assert "1 warnings, 1 info; 1 clean (fail-on: error)" in text
+    summary = json.loads(cli("lint-urdf", ".", "--no-cache", "--format", "json", cwd=tmp_path).stdout)["summary"]
+    assert summary["files_clean"] == 1
+    strict = json.loads(cli("lint-urdf", ".", "--no-cache", "--format", "json", "--fail-on", "warning",
+                            cwd=tmp_path).stdout)["summary"]
+    assert strict["files_clean"] == 0
+    assert cli("scan", ".", "--store", "s.sqlite", cwd=tmp_path).code == 0
+    report = json.loads(cli("scan-report", "s.sqlite", "--keep", "clean", "--format", "json", cwd=tmp_path).stdout)
+    assert report["statuses"]["clean"] == 1 and report["statuses"]["findings"] == 1
+    assert [path.rsplit("/", 1)[-1] for path in report["keep"]["paths"]] == ["info.urdf"]
+    assert [row["path"].rsplit("/", 1)[-1] for row in report["worst"]] == ["bad.urdf", "info.urdf"]
 
 
 def test_a_file_not_checked_fails_the_summary():
@@ -190,7 +218,7 @@ def test_an_undeclared_attribute_prefix_is_a_warning_and_the_rest_is_linted(cli,
 def test_junit_has_one_testcase_per_failing_finding_and_one_failure_at_most(cli, tmp_path):
     (tmp_path / "bad.urdf").write_text(TWO_ERRORS)
     (tmp_path / "good.urdf").write_text(arm())
-    result = cli("lint-urdf", ".", "--no-cache", "--format", "junit", cwd=tmp_path)
+    result = cli("lint-urdf", ".", "--no-cache", "--format", "junit", "--no-group", cwd=tmp_path)
     root = ET.fromstring(result.stdout)
     for case in root.iter("testcase"):  # the common JUnit schema's rule
         assert len(case.findall("failure")) + len(case.findall("error")) <= 1

@@ -42,6 +42,8 @@ def test_pre_commit_hook_blocks_broken_urdf_and_passes_good_one(tmp_path):
     assert blocked.returncode != 0, blocked.stdout + blocked.stderr
     output = blocked.stdout + blocked.stderr
     assert "ar3cli" in output and "I001" in output and "arm.urdf" in output
+    # pre-commit's output is not a terminal: one line per finding, no table rows of 200+ characters
+    assert "arm.urdf:152:3: I001 [error] link 'link_4' moves" in output and "+---" not in output
 
     shutil.copy(ASSETS / "ar3" / "ar3.urdf", project / "arm.urdf")
     _git("add", "-A", cwd=project, env=env)

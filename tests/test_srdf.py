@@ -115,8 +115,8 @@ def test_compare_finds_dangerous_missing_wasted_and_unknown(cli):
     assert marks[frozenset(("link_2", "link_4"))] == "User: cable guard"
     assert marks[frozenset(("base_link", "link_2"))] == "Never"
     assert marks[frozenset(("base_link", "link_3"))] is None
-    text = cli("sample-collisions", str(AR3), "-n", "200", "--srdf-compare", str(FIXTURE))
-    assert text.code == 0, text.stderr
+    text = cli("sample-collisions", str(AR3), "-n", "200", "--srdf-compare", str(FIXTURE), env={"COLUMNS": "1000"})
+    assert text.code == 0, text.stderr  # COLUMNS: a row a line, for the patterns below
     assert "ar3.srdf against the sampled matrix (200 samples)" in text.stdout
     assert re.search(r"\| dangerous +\| link_2 +\| link_4 +\| User: cable guard +\| sometimes", text.stdout)
     assert "ar3.srdf: 7 disabled pairs (5 generated, 2 hand-written); 2 dangerous" in text.stdout

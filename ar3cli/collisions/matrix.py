@@ -29,7 +29,7 @@ import math
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 
-from ar3cli.findings import Finding, Severity
+from ar3cli.findings import Finding, Severity, listed
 from ar3cli.sim.adjacency import direct_parent_child
 from ar3cli.urdf.model import Model
 
@@ -201,7 +201,7 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
     found: list[Finding] = []
     visual_only = [link for link in model.links if link.visuals and link.name not in links]
     if visual_only:
-        names = ", ".join(link.name for link in visual_only)
+        names = listed(link.name for link in visual_only)
         found.append(Finding("visual-only-links", Severity.WARNING,
                              f"{len(visual_only)} link(s) have <visual> but no <collision>: {names}; they never "
                              "collide and count as transparent for adjacency", path, visual_only[0].line,
@@ -224,7 +224,7 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
         if result.category == "sometimes" and result.collisions == 0 and result.limit_hits:
             found.append(Finding("contact-only-at-limits", Severity.INFO,
                                  f"{label} never collided in {result.samples} uniform samples but collide in the "
-                                 f"limit configuration(s) {'; '.join(result.limit_hits)}; kept enabled (MoveIt "
+                                 f"limit configuration(s) {listed(result.limit_hits, separator='; ')}; kept enabled (MoveIt "
                                  "would disable the pair)",
                                  path))
     return found
@@ -268,6 +268,9 @@ def heat_map(links: Sequence[str], pairs: Sequence[tuple[int, int]], results: Se
     """A lower-triangular link x link grid as rich Text (colour by category; plain chars without colour)."""
     from rich.text import Text
 
+    from ar3cli.output.report import printable
+
+    links = [printable(name) for name in links]  # rich would obey a newline or an escape sequence in a name
     cell = {pair: result for pair, result in zip(pairs, results)}
     width = max((len(name) for name in links), default=0)
     digits = len(str(max(len(links) - 1, 0)))

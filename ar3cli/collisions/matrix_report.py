@@ -69,8 +69,16 @@ def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str,
     if merged is not None:
         lines.append(f"merged into {merged.target}: {_count(merged.removed, 'generated pair')} of {merged.source.name} "
                      f"replaced by {merged.written}; {merged.kept} hand-written collision entries kept")
-    return Report(data=data, tables=tables, renderables=[cm.heat_map(run.links, run.pairs, run.results)],
+    drawn = len(run.links) <= HEAT_MAP_LINKS
+    if not drawn:
+        lines.append(f"heat map left out: {len(run.links)} links (at most {HEAT_MAP_LINKS} fit a line; --png draws it)")
+    return Report(data=data, tables=tables, renderables=[cm.heat_map(run.links, run.pairs, run.results)] if drawn else [],
                   lines=[line for line in lines if line])
+
+
+HEAT_MAP_LINKS = 120
+"""Links the text heat map draws at most: it takes two columns per link and a line per link, so a
+robot of 5,000 links would print 50 MB of it."""
 
 
 COMPARE_MEANING = {

@@ -64,12 +64,13 @@ FixHintOption = Annotated[bool, typer.Option(
                        "(JSON: fix_commands).")]
 GroupOption = Annotated[Optional[bool], typer.Option(
     "--group/--no-group", help="Text format: show 5 or more alike findings of one rule in one file as one row "
-                               "(count, first locations, message); on by default. JSON, SARIF, github and markdown "
-                               "keep every finding.", show_default=False)]
+                               "(count, first locations, message); github, markdown, sarif and junit: one "
+                               "annotation, row, result or test case per rule and file. On by default; JSON keeps "
+                               "every finding.", show_default=False)]
 WideOption = Annotated[bool, typer.Option(
-    "--wide", help="Text format: one line per finding, however wide (for grep and wide log viewers). By default "
-                   "tables fit the terminal (or COLUMNS) and wrap messages; piped without COLUMNS, they are one "
-                   "line per row anyway.")]
+    "--wide", help="Text format: the table, one line per finding however wide (for wide log viewers). By "
+                   "default tables fit the terminal (or COLUMNS) and wrap messages; piped without COLUMNS "
+                   "(pre-commit, CI logs), each finding is one line: path:line:col: CODE [severity] message.")]
 BaselineOption = Annotated[Optional[Path], typer.Option(
     "--baseline", metavar="FILE", help="Do not report (or fail on) the findings this baseline file holds; only new "
                                        "ones count.", show_default=False)]

@@ -39,8 +39,11 @@ def scan_report(
         from ar3cli.infra.atomic import atomic_write
 
         paths = report.data["keep"]["paths"]
-        atomic_write(keep_list, "".join(f"{path}\n" for path in paths).encode("utf-8", "surrogateescape"))
-        wrote = f"wrote {len(paths)} paths to {keep_list}"
+        # one path a line: a name holding a line break would write a second, forged path into the list
+        lines = [path for path in paths if "\n" not in path and "\r" not in path]
+        atomic_write(keep_list, "".join(f"{path}\n" for path in lines).encode("utf-8", "surrogateescape"))
+        wrote = f"wrote {len(lines)} paths to {keep_list}" + (
+            f"; left out {len(paths) - len(lines)} whose name holds a line break" if len(lines) < len(paths) else "")
         if format == "markdown":
             log(wrote)  # the Markdown alone on stdout, this line on stderr
         else:

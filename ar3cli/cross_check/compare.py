@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from ar3cli.cross_check.measure import EngineData, Plan
+from ar3cli.findings import listed
 from ar3cli.urdf.model import Model
 
 FLOAT32_EPSILON = 2.0 ** -23
@@ -141,7 +142,7 @@ def _dynamics(model: Model, plan: Plan, pb: EngineData, mj: EngineData) -> list[
         return []
     rows = []
     armature = {n: a for n, a in mj.extra.get("armature", {}).items() if a}
-    hint = ("MuJoCo adds joint armature (" + ", ".join(f"'{n}' {a:g}" for n, a in armature.items())
+    hint = ("MuJoCo adds joint armature (" + listed(f"'{n}' {a:g}" for n, a in armature.items())
             + ") to the mass matrix; PyBullet has none") if armature else ""
     for (label, _), m_pb, m_mj, g_pb, g_mj in zip(plan.configurations, pb.mass_matrix, mj.mass_matrix,
                                                   pb.gravity, mj.gravity):

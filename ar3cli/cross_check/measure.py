@@ -13,6 +13,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from ar3cli.findings import listed
 from ar3cli.urdf.model import Model
 
 GRAVITY = -9.81
@@ -150,7 +151,7 @@ def _mujoco(model: Model, plan: Plan) -> EngineData:
     data = EngineData("mujoco", plan.joints)
     missing = [name for name in plan.joints if name not in robot.joint_ids]
     if missing:
-        data.notes.append("MuJoCo has no 1-DOF joint named " + ", ".join(f"'{n}'" for n in missing))
+        data.notes.append("MuJoCo has no 1-DOF joint named " + listed(f"'{n}'" for n in missing))
     known = [name for name in plan.joints if name in robot.joint_ids]
     data.joints = known
     roots = model.root_links()

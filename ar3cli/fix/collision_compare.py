@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 
 CATEGORY_RANK = {"never": 0, "sometimes": 1, "always": 2, "default": 3}
 """Pair categories by how much collision they say; a move up the ranks means the fix added contacts
@@ -54,7 +55,8 @@ def accept_replacements(model: Any, target: Path, pending: list, inserts: list, 
         if not blamed:
             break
         for replacement in blamed:
-            replacement.refused_because = "; ".join(worse[pair] for pair in worse if replacement.link in pair)
+            replacement.refused_because = listed((worse[pair] for pair in worse if replacement.link in pair),
+                                                 separator="; ")
             accepted.remove(replacement)
     plan.context["comparison"] = {
         "samples": options.samples, "seed": options.seed, "pairs": len(before),
@@ -116,7 +118,7 @@ def comparison_rows(comparison: dict | None) -> list[dict[str, str]]:
     less = comparison["less"]
     detail = (f"{comparison['pairs']} pair(s), {comparison['samples']} samples, seed {comparison['seed']}: "
               f"{len(less)} collide less" + (f" ({', '.join(less[:3])}{', ...' if len(less) > 3 else ''})" if less else "")
-              + (f"; worse: {'; '.join(worse)}" if worse else ", none more"))
+              + (f"; worse: {listed(worse, separator='; ')}" if worse else ", none more"))
     rows = [home, check_row("(robot)", "pair categories, original vs fixed", not worse, detail)]
     return rows
 

@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.fix.driver import Change, Fixer, FixerArgs, FixPlan, Skipped, check_row, verified_in_pybullet
 from ar3cli.fix.settings import setting
 from ar3cli.infra.child_limits import LONG_TIMEOUT_S
@@ -562,7 +563,7 @@ def _checks_in_pybullet(model, expected: dict[str, int], files: dict[str, list[s
             ok = len(shapes) == count and not missing
             detail = f"{len(shapes)} collision shape(s) for {count} <collision>"
             if missing:
-                detail += f"; not loaded: {', '.join(missing)}"
+                detail += f"; not loaded: {listed(missing)}"
             elif files.get(name):
                 detail += f", {len(files[name])} part file(s) loaded"
             checks.append(check_row(f"link {name}", "collision shapes", ok, detail))

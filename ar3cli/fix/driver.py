@@ -23,7 +23,7 @@ from typing import Any, Generic, TypeVar
 
 from ar3cli.errors import EXIT_OK, EXIT_PROBLEMS, UserError
 from ar3cli.infra.atomic import atomic_write, check_writable
-from ar3cli.output.report import OutputFormat, Report, Table, render_report
+from ar3cli.output.report import OutputFormat, Report, Table, printable, render_report
 from ar3cli.urdf.edits import Document
 
 
@@ -359,8 +359,9 @@ def _hunk_range(start: int, stop: int) -> str:
 
 
 def _diff_name(side: str, path: Path) -> str:
-    """``a/urdf/robot.urdf`` for a relative path (as git writes it); an absolute path as it is."""
-    return str(path) if Path(path).is_absolute() else f"{side}/{path}"
+    """``a/urdf/robot.urdf`` for a relative path (as git writes it); an absolute path as it is. Shown
+    as every name is (a newline in the name would end the header line)."""
+    return printable(str(path) if Path(path).is_absolute() else f"{side}/{path}")
 
 
 def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, fmt: OutputFormat) -> int:
@@ -407,5 +408,6 @@ def _report(command: str, results: list[FixResult], *, diff: bool, check: bool, 
         if r.remaining is not None:
             lines.append(_remaining_line(r))
     patch = "".join(r.diff for r in results) if diff else ""
-    render_report(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK, text=patch), fmt)
+    render_report(Report(data=data, tables=[t for t in tables if t.rows], lines=lines, ok=code == EXIT_OK, text=patch,
+                         quoted=True), fmt)
     return code

@@ -32,6 +32,7 @@ from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, number, same_numbers
 from ar3cli.fix.settings import setting
 from ar3cli.urdf.edits import Document
@@ -164,7 +165,7 @@ def _select(model, options: InertiaOptions) -> tuple[dict[str, str], list[LeftAl
 
 
 def _left_alone_note(left_alone: list[LeftAlone]) -> str:
-    names = ", ".join(item.link for item in left_alone)
+    names = listed(item.link for item in left_alone)
     codes = ", ".join(sorted({item.code for item in left_alone}))
     return (f"left {len(left_alone)} link(s) with valid but implausible inertia alone ({codes}): {names}; "
             f"add {INCLUDE_IMPLAUSIBLE} to recompute them")
@@ -210,7 +211,7 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
                                   "or --total-mass")))
             continue
         props = mp.scaled_to_mass(target.geometry.props, target.mass)
-        geometry_source = f"{target.geometry.role}: " + "; ".join(target.geometry.sources)
+        geometry_source = f"{target.geometry.role}: " + listed(target.geometry.sources, separator="; ")
         _write_inertial(document, plan, target.link, props, target.mass_source, geometry_source)
     plan.changes.sort(key=lambda change: change.line)
     plan.skipped.sort(key=lambda skipped: skipped.line)
@@ -289,7 +290,7 @@ def _spread_total_mass(model, targets: list[_Target], pending: list[_Target], to
         target.no_mass = (f"visual geometry only (no <collision>): a marker or decoration, not a physical part, so "
                           f"it gets no share of --total-mass; give --mass {target.link.name}=KG (or --density) if "
                           "it weighs something")
-    left_out = (f"; left out (visual geometry only, no <collision>): {', '.join(t.link.name for t in markers)}"
+    left_out = (f"; left out (visual geometry only, no <collision>): {listed(t.link.name for t in markers)}"
                 if markers else "")
     if not physical:
         plan.notes.append(f"--total-mass: no link without a mass has collision geometry, nothing to spread "
@@ -301,7 +302,7 @@ def _spread_total_mass(model, targets: list[_Target], pending: list[_Target], to
     remainder = total - known
     if not remainder > 0:
         raise UserError(f"--total-mass {number(total)} kg: the other links already weigh {known:.4g} kg, nothing "
-                        f"is left for {', '.join(sorted(t.link.name for t in physical))}")
+                        f"is left for {listed(sorted(t.link.name for t in physical))}")
     volume = sum(t.geometry.volume for t in physical)
     shares = []
     for target in physical:
@@ -313,10 +314,10 @@ def _spread_total_mass(model, targets: list[_Target], pending: list[_Target], to
     unselected = [link.name for link in model.links
                   if link.collisions and link.name not in target_names and _valid_file_mass(link) is None]
     if unselected:
-        left_out += (f"; not selected, and weighing nothing in the file: {', '.join(unselected)} (name them with "
+        left_out += (f"; not selected, and weighing nothing in the file: {listed(unselected)} (name them with "
                      "--links, or use --all, to give them a share)")
     plan.notes.append(f"--total-mass: {known:.4g} kg in links with known masses, {remainder:.4g} kg spread by "
-                      f"collision volume over {len(physical)} link(s): {', '.join(shares)}{left_out}")
+                      f"collision volume over {len(physical)} link(s): {listed(shares)}{left_out}")
 
 
 def _element(link) -> str:

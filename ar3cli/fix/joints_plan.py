@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.fix.driver import Change, Fixer, FixPlan, Skipped, check_row, number, same_numbers, verified_in_pybullet
 from ar3cli.fix.settings import require_positive, setting
 from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
@@ -124,12 +125,12 @@ def plan_joints(model, document: Document, options: JointsOptions) -> FixPlan:
             _velocity_to_radians(document, plan, joint)
     if swapped:
         plan.notes.append(f"note: {model.path}: PyBullet reads lower > upper as 'no limit'; the swapped joint(s) "
-                          f"{', '.join(swapped)} are limited to [lower, upper] there now. If the file meant unlimited, "
+                          f"{listed(swapped)} are limited to [lower, upper] there now. If the file meant unlimited, "
                           "give the real travel instead, or make a revolute joint continuous")
     idiom_paths = flagged_joints(model, UNLIMITED_IDIOM)
     idioms = [joint.name for joint in model.joints if _path(joint.element) in idiom_paths]
     if idioms:
-        plan.notes.append(f"note: {model.path}: left {', '.join(idioms)} alone: lower > upper written as PyBullet's "
+        plan.notes.append(f"note: {model.path}: left {listed(idioms)} alone: lower > upper written as PyBullet's "
                           "'no limit' idiom (lower=\"1\" upper=\"-1\", J014), unlimited in PyBullet; swapping it "
                           "would limit the joint. For a portable file give the real travel, or make a revolute "
                           "joint continuous")

@@ -1,13 +1,12 @@
 """``ar3cli info``'s report: the JSON document, and for people the joint and mass tables, the
-kinematic tree (a rich Tree) and a few summary lines."""
+kinematic tree (an output :class:`~ar3cli.output.report.Tree`) and a few summary lines."""
 
 from __future__ import annotations
 
-from typing import Any
-
+from ar3cli.findings import listed
 from ar3cli.info.summary import JointInfo, Summary
 from ar3cli.info.torques import TOO_WEAK, TorqueCheck
-from ar3cli.output.report import Report, Table, format_cell
+from ar3cli.output.report import Report, Table, Tree, format_cell
 
 ONE_LINE_LIST = 12
 """Name lists longer than this are cut in the summary lines (the JSON has them all)."""
@@ -27,7 +26,7 @@ def library_report(path, library) -> Report:
 
 def report(summary: Summary, tree: bool = True, torques: TorqueCheck | None = None,
            picture: str | None = None) -> Report:
-    """The Report for ``summary``; ``tree=False`` leaves the rich Tree out (JSON needs no rich).
+    """The Report for ``summary``; ``tree=False`` leaves the tree out (JSON has no use for it).
     ``torques`` adds the gravity torque table, its summary and warnings (JSON: ``torques``);
     ``picture`` is the path of the tree picture written (JSON: ``png``)."""
     data = summary.to_dict()
@@ -92,19 +91,16 @@ def mass_table(summary: Summary) -> Table:
                  rows=rows, numeric_columns=("mass (kg)", "share"))
 
 
-def kinematic_tree(summary: Summary) -> Any:
-    """A rich Tree: each root link, and under each link the joints leading to its children."""
-    from rich.text import Text
-    from rich.tree import Tree
-
+def kinematic_tree(summary: Summary) -> Tree:
+    """The kinematic tree: each root link, and under each link the joints leading to its children
+    (the output layer draws it and escapes the names)."""
     children: dict[str | None, list[JointInfo]] = {}
     for joint in summary.joints:
         children.setdefault(joint.parent, []).append(joint)
-    title = f"kinematic tree of {summary.name or summary.path.name}"
-    top = Tree(Text(title, style="bold"), guide_style="dim")
+    top = Tree(f"kinematic tree of {summary.name or summary.path.name}", style="bold")
     seen: set[str] = set()
 
-    def grow(node: Any, link: str) -> None:
+    def grow(node: Tree, link: str) -> None:
         """Iterative, not recursive: a chain of thousands of links (a rope, a snake) stays fine."""
         stack = [(node, link)]
         seen.add(link)
@@ -114,22 +110,25 @@ def kinematic_tree(summary: Summary) -> Any:
             for joint in children.get(link, []):
                 child = joint.child or "?"
                 loop = child in seen
-                branch = node.add(Text(f"{child}  ({joint_label(joint)})" + ("  [loop]" if loop else "")))
+                branch = Tree(f"{child}  ({joint_label(joint)})" + ("  [loop]" if loop else ""))
+                node.children.append(branch)
                 if not loop:
                     seen.add(child)
                     branches.append((branch, child))
             stack += reversed(branches)
 
     for root in summary.roots:
-        grow(top.add(Text(f"{root}  (root)")), root)
+        top.children.append(Tree(f"{root}  (root)"))
+        grow(top.children[-1], root)
     for name in summary.unreachable:
         if name not in seen:
-            grow(top.add(Text(f"{name}  (not reachable from the root)")), name)
+            top.children.append(Tree(f"{name}  (not reachable from the root)"))
+            grow(top.children[-1], name)
     return top
 
 
 def summary_lines(summary: Summary) -> list[str]:
-    roots = ", ".join(summary.roots) or "none"
+    roots = _names(summary.roots) or "none"
     lines = [f"{summary.name or '(no name)'} ({summary.path}): {_count(len(summary.links), 'link')}, "
              f"{_count(len(summary.joints), 'joint')}, "
              f"root link{'s' if len(summary.roots) != 1 else ''} {roots}"]
@@ -168,7 +167,7 @@ def summary_lines(summary: Summary) -> list[str]:
     lines.append(_mesh_line(summary))
     unresolved = summary.meshes.unresolved
     if unresolved:
-        problems = "; ".join(dict.fromkeys(item["problem"] for item in unresolved))
+        problems = listed(dict.fromkeys(item["problem"] for item in unresolved), 3, separator="; ")
         lines.append(f"unresolved meshes ({len(unresolved)} of {summary.meshes.files} files: {problems}): "
                      + _names([item["uri"] for item in unresolved], most=3)
                      + ("" if len(unresolved) <= 3 else "; --format json lists them all"))
@@ -256,6 +255,4 @@ def _count(number: int, noun: str) -> str:
 
 
 def _names(names: list[str], most: int = ONE_LINE_LIST) -> str:
-    if len(names) <= most:
-        return ", ".join(names)
-    return ", ".join(names[:most]) + f", ... ({len(names) - most} more)"
+    return listed(names, most)

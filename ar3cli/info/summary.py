@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.info.meshes import MeshFacts, mesh_facts
 from ar3cli.urdf.bounds import shape_bounds
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Link, Model, Shape
@@ -283,7 +284,7 @@ def _place(summary: Summary, model: Model, frames: Mapping[str, Any]) -> None:
                 placed_mass += info.mass
     if unplaced:
         summary.notes.append(f"centre of mass leaves out {len(unplaced)} link(s) FK could not place: "
-                             + ", ".join(unplaced))
+                             + listed(unplaced))
     if placed_mass > 0:
         centre = weighted / placed_mass
         summary.centre_of_mass = tuple(float(v) for v in centre)  # type: ignore[assignment]

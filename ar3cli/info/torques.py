@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.sim.capture import capture_fds
 from ar3cli.urdf.model import Model
 
@@ -155,7 +156,7 @@ def _compute(model: Model, samples: int, seed: int) -> _Needed:
                  and p.getJointInfo(body.id, joint.index, physicsClientId=client)[2] != p.JOINT_FIXED]
         if multi:
             raise UserError(f"{model.path}: --torques handles 1-DOF joints only; pybullet moves "
-                            f"{', '.join(multi)} with several degrees of freedom")
+                            f"{listed(multi)} with several degrees of freedom")
         joints = body.actuated_joints
         if not joints:
             return _Needed([], [], [], [], [], 0)

@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.kinematics import fk as kinematics
 from ar3cli.urdf.mimic import driven_values
 from ar3cli.urdf.model import Model
@@ -108,7 +109,7 @@ def pybullet_frames(body, samples: Samples) -> dict[str, np.ndarray]:
         broken = body.nonfinite_links(frames)
         if broken:
             raise UserError(f"{body.model.path}: pybullet computes non-finite (NaN) frames for "
-                            f"{', '.join(broken)} in sample {number} (seed {samples.seed}); no comparison is possible")
+                            f"{listed(broken)} in sample {number} (seed {samples.seed}); no comparison is possible")
         poses.append([frames[link] for link in body.link_names])
     return frames_from_poses(body.link_names, poses)
 
@@ -192,7 +193,7 @@ def model_notes(model: Model, body) -> list[str]:
                      "the offset (a floating-base controller must too)")
     missing = [link.name for link in model.links if link.name not in body.link_index]
     if missing:
-        notes.append(f"links not present in pybullet (merged or disconnected): {', '.join(missing)}")
+        notes.append(f"links not present in pybullet (merged or disconnected): {listed(missing)}")
     return notes
 
 

@@ -28,6 +28,7 @@ from typing import Any
 import numpy as np
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.kinematics import fk as kinematics
 from ar3cli.kinematics.fk import DHRow
 from ar3cli.urdf.model import Joint, Model
@@ -118,7 +119,7 @@ def load_dh(path: Path, model: Model) -> DHTable:
         raise UserError(f"{where}: joints must be a list of rows")
     if len(rows) != len(movable):
         raise UserError(f"{where}: {len(rows)} DH row(s), but the chain {base} -> {tip} has {len(movable)} movable "
-                        f"joint(s) ({', '.join(j.name for j in movable)})")
+                        f"joint(s) ({listed(j.name for j in movable)})")
     raw_rows = tuple(_row(row, index, where, model, movable) for index, row in enumerate(rows))
     return DHTable(path=Path(path), convention=convention, base=base, tip=tip, length_unit=length_unit,
                    angle_unit=angle_unit, raw_rows=raw_rows,

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ar3cli.findings import listed
 from ar3cli.kinematics import compare as fk_compare
 from ar3cli.kinematics import dh as dh_module
 from ar3cli.output.report import Report, Table, log
@@ -174,4 +175,4 @@ def _error_table(title: str, first: str, rows: list[list[Any]], caption: str = "
 
 
 def _configuration(values: dict[str, float]) -> str:
-    return ", ".join(f"{name}={value:.6g}" for name, value in values.items())
+    return listed(f"{name}={value:.6g}" for name, value in values.items())

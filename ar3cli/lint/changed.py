@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.infra.git import run_git
 from ar3cli.lint.engine import collect_files, display_path
 
@@ -50,18 +51,13 @@ class ChangedSelection:
                     f"({self.candidates} not checked); nothing to check")
         parts = []
         if self.changed:
-            parts.append(f"{len(self.changed)} changed ({_names(self.changed)})")
+            parts.append(f"{len(self.changed)} changed ({listed(self.changed, 3)})")
         if self.dependents:
             count = len(self.dependents)
             parts.append(f"{count} use{'s' if count == 1 else ''} a changed file ("
-                         + _names([f"{robot} uses {', '.join(used)}" for robot, used in self.dependents.items()])
+                         + listed((f"{robot} uses {listed(used, 3)}" for robot, used in self.dependents.items()), 3)
                          + ")")
         return f"{head} {len(self.files)} of {self.candidates} robot files: {'; '.join(parts)}"
-
-
-def _names(items: list[str], shown: int = 3) -> str:
-    """The first ``shown`` items, and how many more."""
-    return ", ".join(items[:shown]) + (f", and {len(items) - shown} more" if len(items) > shown else "")
 
 
 def select_changed(paths: Iterable[Path], ref: str, package_paths: Mapping[str, Path] | None = None,

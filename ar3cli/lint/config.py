@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.findings import Severity
+from ar3cli.findings import Severity, listed
 
 KNOWN_KEYS = {"select", "ignore", "per-file-ignores", "severity", "fail-on"}
 
@@ -78,7 +78,7 @@ def load_config(start: Path | None = None) -> LintConfig:
     where = f"{path} [tool.ar3cli.lint]"
     unknown = set(table) - KNOWN_KEYS
     if unknown:
-        raise UserError(f"{where}: unknown key(s) {', '.join(sorted(unknown))}; known: {', '.join(sorted(KNOWN_KEYS))}")
+        raise UserError(f"{where}: unknown key(s) {listed(sorted(unknown))}; known: {', '.join(sorted(KNOWN_KEYS))}")
     try:
         config = LintConfig(path)
         if "select" in table:

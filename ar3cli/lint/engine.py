@@ -573,8 +573,11 @@ def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
 
     ``error``/``warning``/``info`` count findings; ``files_with_errors`` the files with at least one
     error finding (so it is 0 exactly when ``error`` is); ``files_not_checked`` the files whose check
-    was cut short (pybullet crashed: exit 2). ``failed`` is the verdict of the summary line: a
-    finding at or above ``fail_on`` (``findings_failing``), or a file not checked.
+    was cut short (pybullet crashed: exit 2); ``files_clean`` the files fully checked with no finding
+    at or above ``fail_on`` (what passes the gate: an info finding such as P003 leaves a file clean
+    under the default ``--fail-on error``; ``scan`` calls the same files clean). ``failed`` is the
+    verdict of the summary line: a finding at or above ``fail_on`` (``findings_failing``), or a file
+    not checked.
     """
     findings = [f for r in results for f in r.findings]
     counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}
@@ -583,7 +586,8 @@ def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
     return {"files": len(results), "files_with_findings": sum(bool(r.findings) for r in results),
             "files_with_errors": sum(any(f.severity is Severity.ERROR for f in r.findings) for r in results),
             "files_not_checked": not_checked,
-            "files_clean": sum(not r.findings and r.error is None for r in results),
+            "files_clean": sum(r.error is None and not any(f.severity >= fail_on for f in r.findings)
+                               for r in results),
             "findings": len(findings), **counts, "fail_on": fail_on.value, "findings_failing": failing,
             "failed": bool(failing or not_checked)}
 

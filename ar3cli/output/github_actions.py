@@ -1,43 +1,65 @@
 """GitHub Actions: workflow-command annotations (``::error file=...::``) and the run's step summary
 (``$GITHUB_STEP_SUMMARY``).
 
-Paths, messages and hints go through :func:`~ar3cli.output.report.printable` first: a link named
-with an escape sequence must not repaint the CI log.
+Every annotation is built by :func:`workflow_command`, whose properties and message go through
+:func:`~ar3cli.output.escape.github_property` / :func:`~ar3cli.output.escape.github_data`: a link
+named with a newline cannot start a line of its own (a forged ``::stop-commands::``), an escape
+sequence cannot repaint the CI log.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 
-from ar3cli.findings import Finding, Severity
-from ar3cli.output.report import printable
+from ar3cli.findings import Severity
+from ar3cli.output.escape import github_data, github_property
 
 COMMANDS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "notice"}
 
+ANNOTATIONS_PER_RUN = 50
+"""Annotations one run writes at most; the rest are counted in one last notice. GitHub shows 10 of
+each kind per step and 50 per job, so more would only fill the log (5,000 S005 findings once wrote
+170 MB of them)."""
 
-def escape_data(text: str) -> str:
-    """Escape a command's message (workflow-commands spec: %, CR, LF)."""
-    return text.replace("%", "%25").replace("\r", "%0D").replace("\n", "%0A")
+STEP_SUMMARY_LIMIT = 1024 * 1024
+"""Bytes GitHub accepts in one step's summary (``$GITHUB_STEP_SUMMARY``): a larger file is not
+shown at all, and the step gets an error annotation instead."""
 
 
-def escape_property(text: str) -> str:
-    """Escape a property value: the message escapes plus ``:`` and ``,``."""
-    return escape_data(text).replace(":", "%3A").replace(",", "%2C")
+def workflow_command(kind: str, message: str | Sequence[str], *, file: str = "", line: int = 0, column: int = 0,
+                     title: str = "") -> str:
+    """``::KIND file=F,line=L,col=C,title=T::MESSAGE``, each part escaped for its place. ``message`` is
+    one line, or a sequence of lines that GitHub shows as the lines of one annotation (joined by an
+    encoded newline; a newline inside a line is shown as ``\\x0a``, as everywhere)."""
+    properties = []
+    if file:
+        properties.append(f"file={github_property(file)}")
+        if line:
+            properties.append(f"line={int(line)}")
+            if column:
+                properties.append(f"col={int(column)}")
+    if title:
+        properties.append(f"title={github_property(title)}")
+    text = github_data(message) if isinstance(message, str) else "%0A".join(map(github_data, message))
+    return f"::{kind}{' ' + ','.join(properties) if properties else ''}::{text}"
 
 
-def annotation(finding: Finding) -> str:
-    """``::error file=PATH,line=L,col=C,title=CODE::message (fix: hint)``."""
-    properties = [f"file={escape_property(printable(finding.path))}"]
-    if finding.line:
-        properties += [f"line={finding.line}", f"col={max(finding.column, 1)}"]
-    properties.append(f"title={escape_property(printable(finding.rule))}")
-    message = finding.message + (f" (fix: {finding.hint})" if finding.hint else "")
-    return f"::{COMMANDS[finding.severity]} {','.join(properties)}::{escape_data(printable(message))}"
+def capped_annotations(lines: list[str], what: str = "findings") -> str:
+    """``lines`` (one annotation each), at most :data:`ANNOTATIONS_PER_RUN`, the rest counted in one notice."""
+    shown = lines[:ANNOTATIONS_PER_RUN]
+    if len(lines) > len(shown):
+        shown.append(workflow_command(
+            "notice", f"{len(lines) - len(shown)} more annotations of {what} left out (GitHub shows the first 10 "
+                      "of each kind per step): the step summary and --format json list them all",
+            title="ar3cli"))
+    return "".join(line + "\n" for line in shown)
 
 
 def append_step_summary(markdown: str) -> str | None:
     """Append ``markdown`` to the file ``$GITHUB_STEP_SUMMARY`` names (GitHub Actions shows it on the
-    run's summary page); nothing when the variable is unset or empty.
+    run's summary page); nothing when the variable is unset or empty. Past
+    :data:`STEP_SUMMARY_LIMIT`, the text is cut at a line and says so.
 
     Returns None, or the one-line error when the file cannot be written (for ``Report.errors``:
     the annotations are still printed, and the exit code says something went wrong).
@@ -45,9 +67,14 @@ def append_step_summary(markdown: str) -> str | None:
     path = os.environ.get("GITHUB_STEP_SUMMARY")
     if not path:
         return None
+    data = markdown.encode("utf-8", "backslashreplace")
+    if len(data) > STEP_SUMMARY_LIMIT - 4096:
+        cut = data.rfind(b"\n", 0, STEP_SUMMARY_LIMIT - 4096) + 1
+        data = data[:cut] + (f"\n_(cut at {cut:,} bytes: GitHub shows at most 1 MiB per step; --format json lists "
+                             "every finding)_\n").encode()
     try:
-        with open(path, "a", encoding="utf-8") as handle:
-            handle.write(markdown)
+        with open(path, "ab") as handle:
+            handle.write(data)
     except OSError as exc:
         return f"cannot append to $GITHUB_STEP_SUMMARY ({path}): {exc.strerror or exc}"
     return None

@@ -3,7 +3,8 @@ Content-Security-Policy that forbids any network request), the JSON data island,
 the findings section (lint-urdf's ``--format html`` and ``report`` show findings the same way).
 
 Robot files are untrusted, so every string that came from one (names, messages, paths, source
-lines) reaches the page through :func:`esc` (``html.escape`` with quotes), and the data island is
+lines) reaches the page through :func:`esc` (``html.escape`` with quotes, control characters and
+bidi overrides shown as ``\\xNN``: :func:`ar3cli.output.escape.html_text`), and the data island is
 JSON with ``<``, ``>`` and ``&`` written as ``\\u003c``..., so no name can close the script element.
 Colours are the Okabe-Ito palette (safe for the common colour-vision deficiencies), and severity
 is always written out as a word next to its colour.
@@ -11,10 +12,11 @@ is always written out as a word next to its colour.
 
 from __future__ import annotations
 
-import html
 import json
 from collections.abc import Iterable, Mapping
 from typing import Any
+
+from ar3cli.output.escape import html_text
 
 CSP = ("default-src 'none'; img-src data:; style-src 'unsafe-inline'; script-src 'unsafe-inline'; "
        "base-uri 'none'; form-action 'none'")
@@ -98,9 +100,9 @@ sees), expand/collapse buttons, a collapsed section opened when a link (the verd
 navigation's) or the address leads to it, and every <details> opened for printing."""
 
 
-def esc(value: Any) -> str:
-    """Text for HTML content or a quoted attribute; None is an empty string."""
-    return "" if value is None else html.escape(str(value), quote=True)
+esc = html_text
+"""Text for HTML content or a quoted attribute; None is an empty string (control characters shown,
+as in every output: :func:`ar3cli.output.escape.html_text`)."""
 
 
 def number(value: Any, digits: int = 4) -> str:

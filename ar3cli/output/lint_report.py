@@ -8,11 +8,11 @@ page's source lines) as values and functions.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
-from ar3cli.findings import Finding
+from ar3cli.findings import Finding, listed
 from ar3cli.output.report import Report, log
 
 
@@ -31,7 +31,8 @@ class LintReport:
     rules: Callable[[], list[Any]]
     """The rules that ran (SARIF's ``tool.driver.rules``)."""
     group: Callable[[list[Finding]], list[Any]] | None = None
-    """Folds alike findings of the text table into one row (``--group``); None: a row each."""
+    """Folds alike findings of the text table into one row (``--group``); None: a row each, and in
+    the CI formats an annotation, row, result or test case each (see :func:`rule_groups`)."""
     context: Callable[[list[Finding]], dict[str, Any]] = lambda findings: {}
     """What the html page shows with each finding (source lines, fix commands)."""
     note: str | None = None
@@ -90,3 +91,67 @@ def completed(lint: LintReport, report: Report, *, text: bool = False, hints: bo
     report.wide = lint.wide
     report.errors = [*report.errors, *(result.error for result in lint.results if result.error)]
     return report
+
+
+HEADLINE = 200
+"""Characters of a message a CI format shows in its first line; the rest (G001's places looked in,
+seven paths of ~900 characters) goes to the details."""
+GROUP_PLACES = 5
+"""Line numbers a grouped annotation, row or test case names."""
+
+
+@dataclass(frozen=True)
+class RuleGroup:
+    """The findings of one rule in one file: what the CI formats show as one annotation (github),
+    one row (markdown, the step summary), one result with related locations (sarif), one test case
+    (junit). The text table groups by message shape instead (``LintReport.group``)."""
+
+    findings: tuple[Finding, ...]
+
+    @property
+    def first(self) -> Finding:
+        return self.findings[0]
+
+    @property
+    def count(self) -> int:
+        return len(self.findings)
+
+    @property
+    def alike(self) -> bool:
+        """Every finding has the first one's message."""
+        return all(finding.message == self.first.message for finding in self.findings)
+
+    def summary(self) -> str:
+        """``headline``, or ``7x: headline (and 6 more like it)``."""
+        text = headline(self.first.message)
+        if self.count == 1:
+            return text
+        return f"{self.count}x: {text}" + ("" if self.alike else f" (and {self.count - 1:,} more like it)")
+
+    def places(self, most: int = GROUP_PLACES) -> str:
+        """``12:5, 14:5, 20:1 and 4 more`` (line:column of each finding that has a line)."""
+        return listed((f"{f.line}:{f.column or 1}" for f in self.findings if f.line), most)
+
+
+def headline(message: str, limit: int = HEADLINE) -> str:
+    """``message`` up to its first ``"; "`` when it is longer than ``limit`` (that part fits), else cut
+    at ``limit``; ``...`` says it was cut (the details and ``--format json`` hold all of it)."""
+    if len(message) <= limit:
+        return message
+    cut = message.find("; ")
+    if 0 < cut <= limit:
+        return message[:cut] + "; ..."
+    return message[:limit - 3].rstrip() + "..."
+
+
+def rule_groups(findings: Sequence[Finding], grouped: bool = True) -> list[RuleGroup]:
+    """The findings of each rule in each file as one :class:`RuleGroup` (with ``grouped`` False, a
+    group per finding), errors first, then warnings, then info; in run order within a severity."""
+    if not grouped:
+        groups = [RuleGroup((finding,)) for finding in findings]
+    else:
+        members: dict[tuple, list[Finding]] = {}
+        for finding in findings:
+            members.setdefault((finding.path, finding.rule, finding.severity), []).append(finding)
+        groups = [RuleGroup(tuple(alike)) for alike in members.values()]
+    return sorted(groups, key=lambda group: -group.first.severity.rank)

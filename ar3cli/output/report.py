@@ -2,14 +2,16 @@
 
 Text goes to a rich console on a terminal (tables with colour, without it when ``NO_COLOR`` is
 set), fitted to its width (``COLUMNS`` wins): long cells wrap inside their column. Off a terminal
-(pipes, CI logs, pre-commit) tables are plain ASCII, one line per row (what grep and log viewers
-want), unless ``COLUMNS`` is set: then they fit that width the same way; rich is not even imported
-unless the report holds rich renderables. ``Report.wide`` (lint-urdf's ``--wide``) asks for one
-line per row everywhere. Names from robot files (paths, links, joints) reach text output through
-:func:`printable`, so a control character in them (a terminal escape sequence, ``\\r``, a bidi
-override) is shown as ``\\x1b``, never obeyed by the terminal; JSON keeps the exact strings. JSON goes to stdout alone, so
-``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing to write
-the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
+(pipes, CI logs, pre-commit) tables are plain ASCII fitted to ``COLUMNS``, or to
+:data:`PIPED_WIDTH` (100) when it is not set, and lint findings are one line each
+(:mod:`ar3cli.output.formats.text`); rich is not even imported unless the report holds rich
+renderables. ``Report.wide`` (lint-urdf's ``--wide``) asks for one line per row everywhere. Names
+from robot files, file names and the environment reach text output through :func:`printable`
+(:func:`ar3cli.output.escape.terminal`), so a control character in them (a newline, a terminal
+escape sequence, ``\\r``, a bidi override) is shown as ``\\x1b``, never obeyed; JSON keeps the exact
+strings. Tables show at most :data:`~ar3cli.output.lists.TABLE_ROWS` rows. JSON goes to stdout
+alone, so ``ar3cli ... --format json | jq`` always works; progress and logs go to stderr. Failing
+to write the output (a full disk) is a one-line :class:`~ar3cli.errors.UserError`.
 Which formats a user can choose, and which reports each renders, is the registry of
 :mod:`ar3cli.output.formats`; every format ends here, writing the Report it made as text or JSON.
 """
@@ -20,13 +22,13 @@ import enum
 import json
 import math
 import os
-import re
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, NoReturn, TextIO
 
 from ar3cli.errors import EXIT_USAGE, UserError
+from ar3cli.output.escape import terminal
 
 
 class OutputFormat(str, enum.Enum):
@@ -60,6 +62,62 @@ class Table:
 
 
 @dataclass
+class Tree:
+    """A tree of labels (``info``'s kinematic tree), drawn by the output layer: with rich's guides on
+    a terminal, indented ASCII elsewhere; labels through :func:`printable`. At most
+    :data:`~ar3cli.output.lists.TABLE_ROWS` nodes are drawn, and no deeper than :data:`TREE_DEPTH`
+    levels of indentation (a chain of 4,000 links would otherwise print 32 MB of guides)."""
+
+    label: str
+    children: list[Tree] = field(default_factory=list)
+    style: str = ""
+
+
+TREE_DEPTH = 32
+"""Levels a tree is indented at most; deeper nodes are drawn at that level with ``[depth N]``."""
+
+
+def tree_lines(tree: Tree) -> list[tuple[int, str, str]]:
+    """(indentation level, label, style) of each node drawn, depth first, iteratively (a chain of
+    thousands of links is fine); the last line counts the nodes left out."""
+    from ar3cli.output.lists import TABLE_ROWS, left_out
+
+    out: list[tuple[int, str, str]] = []
+    stack = [(tree, 0)]
+    left = 0
+    while stack:
+        node, depth = stack.pop()
+        if len(out) >= TABLE_ROWS:
+            left += 1
+        else:
+            label = printable(node.label) if depth <= TREE_DEPTH else f"[depth {depth}] {printable(node.label)}"
+            out.append((min(depth, TREE_DEPTH), label, node.style))
+        stack += [(child, depth + 1) for child in reversed(node.children)]
+    if left:
+        out.append((1, left_out(left, "nodes"), ""))
+    return out
+
+
+def plain_tree(tree: Tree) -> str:
+    """:func:`tree_lines` as indented ASCII (two spaces a level, ``- `` before each node but the root)."""
+    return "".join(("  " * (depth - 1) + "- " if depth else "") + label + "\n" for depth, label, _ in tree_lines(tree))
+
+
+def rich_tree(tree: Tree) -> Any:
+    """:func:`tree_lines` as a rich Tree (guides on a terminal)."""
+    from rich.text import Text
+    from rich.tree import Tree as RichTree
+
+    lines = tree_lines(tree)
+    top = RichTree(Text(lines[0][1], style=lines[0][2]), guide_style="dim")
+    parents = [top]
+    for depth, label, style in lines[1:]:
+        del parents[depth:]
+        parents.append(parents[-1].add(Text(label, style=style)))
+    return top
+
+
+@dataclass
 class Report:
     """What a command found: ``data`` is the JSON document, ``tables``/``lines`` its text form."""
 
@@ -68,10 +126,15 @@ class Report:
     lines: list[str] = field(default_factory=list)
     ok: bool = True
     renderables: list[Any] = field(default_factory=list)
-    """Extra rich renderables (e.g. a heat map), printed after the tables in text mode."""
+    """Extra renderables, printed after the tables in text mode: a :class:`Tree`, or a rich
+    renderable (the collision heat map) whose command escaped its names with :func:`printable`."""
     text: str = ""
     """A verbatim payload for stdout (a unified diff, workflow annotations, Markdown). When set, text
     mode writes it to stdout alone and moves tables and lines to stderr, so the payload can be piped."""
+    quoted: bool = False
+    """``text`` quotes a robot file (a fixer's unified diff): written through
+    :func:`~ar3cli.output.escape.terminal_lines`, and inside GitHub Actions between
+    ``::stop-commands::`` and its end, so a line of the file cannot be read as a workflow command."""
     errors: list[str] = field(default_factory=list)
     """One-line errors about part of the work (a file whose pybullet run crashed) while the rest was
     reported: written to stderr as ``ar3cli: error: ...`` in every format, and the exit code is 2."""
@@ -94,19 +157,9 @@ def console(stderr: bool = False):
                    force_terminal=False if plain else None)
 
 
-_CONTROL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u061c\u200e\u200f\u202a-\u202e\u2066-\u2069]")
-"""Characters a terminal or a log viewer obeys instead of showing: C0 controls but tab and
-newline (ESC starts escape sequences, CR rewrites the line, BS erases), DEL, C1 controls (CSI
-0x9b), and the bidirectional marks, embeddings, overrides and isolates (the "Trojan Source" ones)."""
-
-
-def printable(text: str) -> str:
-    """``text`` with every :data:`_CONTROL` character written as ``\\xNN`` (``\\uNNNN`` above
-    0xff): what every text, github and markdown output does with names that come from robot files."""
-    if text.isprintable():  # the usual case, one C-level scan
-        return text
-    return _CONTROL.sub(lambda match: f"\\x{ord(match.group()):02x}" if ord(match.group()) < 0x100
-                        else f"\\u{ord(match.group()):04x}", text)
+printable = terminal
+"""What every text output does with names, paths and messages: :func:`ar3cli.output.escape.terminal`
+(one line, control characters shown as ``\\xNN``)."""
 
 
 def format_cell(value: Any) -> str:
@@ -124,40 +177,59 @@ def format_cell(value: Any) -> str:
     return printable(str(value))
 
 
+PIPED_WIDTH = 100
+"""Columns a table takes off a terminal (a pipe, a CI log, pre-commit) when ``COLUMNS`` is not set:
+rows of 200-330 characters are hard to read in a log viewer; wider cells wrap inside their column."""
+
+
+def _columns_set() -> int | None:
+    columns = os.environ.get("COLUMNS", "").strip()
+    return int(columns) if columns.isdigit() and int(columns) >= 20 else None
+
+
 def table_width(stream: TextIO, wide: bool = False) -> int | None:
     """How many columns a text table on ``stream`` may take; None for no limit (one line per row).
 
     ``wide`` (``--wide``): no limit. Else ``COLUMNS`` when set (at least 20, so a stray tiny value
-    cannot fold every word), else the terminal's width, else (a pipe, a file, a CI log) no limit.
+    cannot fold every word), else the terminal's width, else (a pipe, a file, a CI log) :data:`PIPED_WIDTH`.
     """
     if wide:
         return None
-    columns = os.environ.get("COLUMNS", "").strip()
-    if columns.isdigit() and int(columns) >= 20:
-        return int(columns)
+    columns = _columns_set()
+    if columns is not None:
+        return columns
     if stream.isatty():
         import shutil
 
         return shutil.get_terminal_size().columns
-    return None
+    return PIPED_WIDTH
+
+
+def piped(stream: TextIO) -> bool:
+    """``stream`` is not a terminal and ``COLUMNS`` does not say how wide its reader is: pre-commit,
+    a CI log, ``| grep``. Lint findings are then one line each (:mod:`ar3cli.output.formats.text`)."""
+    return _columns_set() is None and not stream.isatty()
 
 
 MIN_WRAPPED_WIDTH = 12
 """A wrapped column narrower than this reads as a word list: the table is printed as blocks."""
 
 
-def plain_table(table: Table, width: int | None = None) -> str:
+def plain_table(table: Table, width: int | None = None, blocks: bool = True) -> str:
     """An ASCII table: one line per row when ``width`` is None, else fitted into ``width`` columns.
 
     Fitting keeps the short columns whole (location, code, severity, numbers: what grep looks for,
     on each row's first line) and wraps the long ones (message, hint) inside their cells; when the
-    long ones would get fewer than :data:`MIN_WRAPPED_WIDTH` columns, each row is a block instead
-    (:func:`plain_blocks`). Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's
+    table cannot fit without splitting words and numbers, each row is a block instead
+    (:func:`plain_blocks`: the short cells on one line, the long ones below), or, with ``blocks``
+    False (a pipe's default width, which is no reader's limit), the table as narrow as it goes
+    without splitting them. Rich's layout engine takes ~0.6 ms per row (0.4 s for pybullet_data's
     659 lint findings); this plain formatter is what pipes, CI logs and ``--wide`` get.
     """
-    rows = [[format_cell(value).replace("\n", " ") for value in row] for row in table.rows]
+    rows = [[format_cell(value) for value in row] for row in table.rows]
     natural = [max([len(column), *(len(row[index]) for row in rows)]) for index, column in enumerate(table.columns)]
-    widths = natural if width is None else _fitted_widths(table, natural, rows, width - 3 * len(natural) - 1)
+    room = None if width is None else width - 3 * len(natural) - 1
+    widths = natural if room is None else _fitted_widths(table, natural, rows, room, narrowest=not blocks)
     if widths is None:
         return plain_blocks(table, rows, width or 80)
     numeric = [column in table.numeric_columns for column in table.columns]
@@ -181,31 +253,57 @@ def plain_table(table: Table, width: int | None = None) -> str:
     return "\n".join(out) + "\n"
 
 
+def piped_table(table: Table, stream: TextIO, wide: bool = False) -> str:
+    """:func:`plain_table` as ``stream`` takes it off a terminal: the width of :func:`table_width`;
+    blocks only for a width someone chose (``COLUMNS``), not for a pipe's default."""
+    return plain_table(table, table_width(stream, wide), blocks=not piped(stream))
+
+
 def _wrap(text: str, size: int) -> list[str]:
     import textwrap
 
     return textwrap.wrap(text, size, break_on_hyphens=False) or [""]
 
 
-def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room: int) -> list[int] | None:
+def _fitted_widths(table: Table, natural: list[int], rows: list[list[str]], room: int,
+                   narrowest: bool = False) -> list[int] | None:
     """Column widths that fit ``room`` characters of cells: the long text columns capped at one
-    common width (the widest shrink first), the others whole; None when that cap is too small."""
+    common width (the widest shrink first), never below their longest word (up to
+    :data:`LONGEST_WORD`: a joint name is not split) nor :data:`MIN_WRAPPED_WIDTH`; the others
+    whole, their headers wrapped when that is still too wide. None when even that does not fit,
+    or with ``narrowest`` those smallest widths."""
     if sum(natural) <= room:
         return natural
     flexible = [index for index, column in enumerate(table.columns)
                 if column not in table.nowrap_columns and column not in table.numeric_columns
                 and column != table.status_column and natural[index] > 16]
-    left = room - sum(size for index, size in enumerate(natural) if index not in flexible)
-    count = len(flexible)
-    for size in sorted(natural[index] for index in flexible):
-        if size * count > left:
-            break
-        left -= size
-        count -= 1
-    if not count or left // count < MIN_WRAPPED_WIDTH:
-        return None
-    cap = left // count
-    return [min(size, cap) if index in flexible else size for index, size in enumerate(natural)]
+    floors = {index: min(natural[index], max(MIN_WRAPPED_WIDTH, min(LONGEST_WORD, max(
+        len(word) for text in [table.columns[index], *(row[index] for row in rows)] for word in [*text.split(), ""]))))
+        for index in flexible}
+    whole = list(natural)
+    if sum(natural[index] if index not in flexible else floors[index] for index in range(len(natural))) > room:
+        # still too wide: the headers of the other columns may wrap too ("declared effort" over "20 N m")
+        whole = [max([len(row[index]) for row in rows] + [len(word) for word in column.split()])
+                 if index not in flexible else size for index, (column, size) in enumerate(zip(table.columns, natural))]
+    fixed = sum(size for index, size in enumerate(whole) if index not in flexible)
+
+    def width(cap: int, index: int) -> int:
+        return max(floors[index], min(natural[index], cap))
+
+    def total(cap: int) -> int:
+        return fixed + sum(width(cap, index) for index in flexible)
+
+    if total(0) > room:
+        return [width(0, index) if index in flexible else size for index, size in enumerate(whole)] if narrowest else None
+    low, high = 0, max((natural[index] for index in flexible), default=0)
+    while low < high:  # the largest common cap that fits
+        middle = (low + high + 1) // 2
+        low, high = (middle, high) if total(middle) <= room else (low, middle - 1)
+    return [width(low, index) if index in flexible else size for index, size in enumerate(whole)]
+
+
+LONGEST_WORD = 30
+"""A word up to this long keeps its column wide enough to stay whole; longer ones (paths) may break."""
 
 
 def plain_blocks(table: Table, rows: list[list[str]], width: int) -> str:
@@ -251,12 +349,27 @@ def render_rows_as_blocks(table: Table, out) -> None:
                 out.print(Padding(Text(f"{column}: {row[index]}"), (0, 0, 0, 4)))
 
 
+def bounded(table: Table) -> Table:
+    """``table`` with at most :data:`~ar3cli.output.lists.TABLE_ROWS` rows, its caption counting the
+    rows left out (the JSON document keeps them)."""
+    from dataclasses import replace
+
+    from ar3cli.output.lists import capped, left_out
+
+    rows, left = capped(table.rows)
+    if not left:
+        return table
+    return replace(table, rows=list(rows), caption=" ".join(filter(None, [table.caption, left_out(left)])))
+
+
 def render_table(table: Table, out=None, wide: bool = False) -> None:
     """Print one :class:`Table`: through rich on a terminal (as blocks when it is narrow), as
-    :func:`plain_table` elsewhere and with ``wide``."""
+    :func:`plain_table` elsewhere and with ``wide``; at most
+    :data:`~ar3cli.output.lists.TABLE_ROWS` rows (:func:`bounded`)."""
     out = out or console()
+    table = bounded(table)
     if wide or not out.is_terminal:
-        out.file.write(plain_table(table, table_width(out.file, wide)))
+        out.file.write(piped_table(table, out.file, wide))
         out.file.flush()
         return
     if out.width < NARROW_TERMINAL and len(table.columns) > 3:
@@ -328,13 +441,15 @@ def render_report(report: Report, fmt: OutputFormat | str) -> None:
         emit_json(report.data)
         return
     if report.text:
-        write(sys.stdout, report.text)
+        write(sys.stdout, quoted(report.text) if report.quoted else report.text)
     stream = sys.stderr if report.text else sys.stdout
-    if not report.renderables and (report.wide or not stream.isatty()):
+    trees = all(isinstance(renderable, Tree) for renderable in report.renderables)
+    if trees and (report.wide or not stream.isatty()):
         # What render_table would print off a terminal, without creating a console: importing rich
         # costs ~25 ms of every piped run.
-        width = table_width(stream, report.wide)
-        write(stream, "".join([*(plain_table(table, width) for table in report.tables),
+        write(stream, "".join([*(piped_table(bounded(table), stream, report.wide) for table in report.tables),
+                               *("\n" + plain_tree(tree) for tree in report.renderables),
+                               "\n" if report.renderables else "",
                                *(printable(line) + "\n" for line in report.lines)]))
         return
     out = console(stderr=bool(report.text))
@@ -342,11 +457,27 @@ def render_report(report: Report, fmt: OutputFormat | str) -> None:
         render_table(table, out, report.wide)
     for renderable in report.renderables:
         out.print()
-        out.print(renderable)
+        out.print(rich_tree(renderable) if isinstance(renderable, Tree) else renderable)
     if report.renderables:
         out.print()
     for line in report.lines:
         out.print(printable(line), markup=False)
+
+
+def quoted(text: str) -> str:
+    """A robot file's lines for stdout (:attr:`Report.quoted`): each line escaped; inside GitHub
+    Actions (``GITHUB_ACTIONS=true``) between ``::stop-commands::TOKEN`` and ``::TOKEN::`` with a
+    random token, GitHub's own way to print text that must not run workflow commands (a file line
+    `` ::error::x`` would otherwise be one: the runner ignores leading spaces)."""
+    from ar3cli.output.escape import terminal_lines
+
+    text = terminal_lines(text)
+    if os.environ.get("GITHUB_ACTIONS") != "true" or "::" not in text:
+        return text
+    import secrets
+
+    token = secrets.token_hex(16)
+    return f"::stop-commands::{token}\n{text}{'' if text.endswith(chr(10)) else chr(10)}::{token}::\n"
 
 
 def finish(report: Report, fmt: OutputFormat | str) -> NoReturn:

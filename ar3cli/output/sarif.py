@@ -8,6 +8,7 @@ from typing import Any
 
 from ar3cli import __version__
 from ar3cli.findings import Finding, Severity
+from ar3cli.output.lint_report import rule_groups
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
 RULES_URL = "https://github.com/ar3cli/ar3cli/blob/main/docs/rules.md"
@@ -26,8 +27,16 @@ def artifact_uri(path: str) -> str:
     return Path(relative).as_posix() if not relative.startswith("..") else candidate.as_uri()
 
 
-def sarif_document(findings: list[Finding], rules) -> dict[str, Any]:
-    """One SARIF log with one run: the tool's rule metadata and one result per finding."""
+def _physical(finding: Finding) -> dict[str, Any]:
+    location: dict[str, Any] = {"artifactLocation": {"uri": artifact_uri(finding.path)}}
+    if finding.line:
+        location["region"] = {"startLine": finding.line, "startColumn": max(finding.column, 1)}
+    return location
+
+
+def sarif_document(findings: list[Finding], rules, grouped: bool = True) -> dict[str, Any]:
+    """One SARIF log with one run: the tool's rule metadata and one result per rule and file (its
+    other findings as ``relatedLocations``, errors first); ``grouped`` False: a result per finding."""
     index = {rule.code: i for i, rule in enumerate(rules)}
     driver = {
         "name": "ar3cli",
@@ -45,17 +54,21 @@ def sarif_document(findings: list[Finding], rules) -> dict[str, Any]:
         } for rule in rules],
     }
     results = []
-    for finding in findings:
-        location: dict[str, Any] = {"artifactLocation": {"uri": artifact_uri(finding.path)}}
-        if finding.line:
-            location["region"] = {"startLine": finding.line, "startColumn": max(finding.column, 1)}
+    for group in rule_groups(findings, grouped):
+        first = group.first
+        text = first.message + (f" ({group.count} findings of {first.rule} in this file: the first here, the others "
+                                "as related locations)" if group.count > 1 else "")
         result: dict[str, Any] = {
-            "ruleId": finding.rule,
-            "level": LEVELS[finding.severity],
-            "message": {"text": finding.message + (f" Fix: {finding.hint}" if finding.hint else "")},
-            "locations": [{"physicalLocation": location}],
+            "ruleId": first.rule,
+            "level": LEVELS[first.severity],
+            "message": {"text": text + (f" Fix: {first.hint}" if first.hint else "")},
+            "locations": [{"physicalLocation": _physical(first)}],
         }
-        if finding.rule in index:
-            result["ruleIndex"] = index[finding.rule]
+        if group.count > 1:
+            result["relatedLocations"] = [{"id": number, "physicalLocation": _physical(finding),
+                                           "message": {"text": finding.message}}
+                                          for number, finding in enumerate(group.findings[1:], 1)]
+        if first.rule in index:
+            result["ruleIndex"] = index[first.rule]
         results.append(result)
     return {"$schema": SCHEMA, "version": "2.1.0", "runs": [{"tool": {"driver": driver}, "results": results}]}

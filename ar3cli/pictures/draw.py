@@ -19,6 +19,7 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.infra.atomic import atomic_write
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 from ar3cli.urdf.model import Model
@@ -229,8 +230,8 @@ def _draw(model: Model, configuration: Mapping[str, float], width: int, height: 
         joints = {joint.name: joint for joint in body.actuated_joints}
         unknown = sorted(set(configuration) - set(joints))
         if unknown:
-            raise UserError(f"--config names unknown joints: {', '.join(unknown)} "
-                            f"(movable joints: {', '.join(joints) or 'none'})")
+            raise UserError(f"--config names unknown joints: {listed(unknown)} "
+                            f"(movable joints: {listed(joints) or 'none'})")
         values = configuration_with_mimics(body, configuration)
         body.set_positions(values)
         contacts = nonadjacent_collisions(body, model) if show_contacts else []

@@ -62,49 +62,50 @@ def report(diffs: Sequence[RobotDiff], tolerance: Tolerance, samples: int, seed:
     return Report(data, tables, lines, ok=not data["changed"], errors=list(errors))
 
 
-def _cell(value: Any) -> str:
-    from ar3cli.output.markdown_table import markdown_cell
-
-    return markdown_cell(value if isinstance(value, str) else show(value))
+def _tables(diff: RobotDiff, samples: int, seed: int) -> list[tuple[str, Table]]:
+    """The tables of one robot's diff for a Markdown page (the robot is in the heading), each with
+    the line that introduces it (or none)."""
+    tables = []
+    if diff.changes:
+        tables.append(("", Table("", CHANGE_COLUMNS, [[c.section, c.element, c.what, c.old, c.new,
+                                                       _amount(c.amount, c.unit),
+                                                       f"{c.file}:{c.line}" if c.line else c.file]
+                                                      for c in diff.changes])))
+    if diff.displacements:
+        tables.append((f"End effectors moved (home pose and {samples} samples, seed {seed}):",
+                       Table("", KINEMATIC_COLUMNS, [_kinematic_row(moved) for moved in diff.displacements])))
+    if diff.findings:
+        tables.append(("", Table("", ["lint", "rule", "severity", "message"],
+                                 [[f.status, f.rule, f.severity, f.message] for f in diff.findings])))
+    return tables
 
 
 def markdown(diffs: Sequence[RobotDiff], samples: int, seed: int) -> str:
-    """GitHub-flavoured Markdown: a heading per robot, its changes, moved end effectors and findings."""
-    out = ["## ar3cli diff", "", verdict(diffs), ""]
+    """GitHub-flavoured Markdown: a heading per robot, its changes, moved end effectors and findings
+    (every cell escaped by the output layer's Markdown tables)."""
+    from ar3cli.output.escape import markdown_code, markdown_text
+    from ar3cli.output.markdown_table import table_markdown
+
+    out = ["## ar3cli diff", "", markdown_text(verdict(diffs)), ""]
     for diff in diffs:
-        out += [f"### `{_cell(diff.old)}` → `{_cell(diff.new)}`", ""]
+        out += [f"### {markdown_code(diff.old)} → {markdown_code(diff.new)}", ""]
         if not diff.changed:
             out += ["No semantic change.", ""]
-        if diff.changes:
-            out += ["| " + " | ".join(CHANGE_COLUMNS) + " |", "|" + " --- |" * len(CHANGE_COLUMNS)]
-            out += ["| " + " | ".join(_cell(v) for v in (c.section, c.element, c.what, c.old, c.new,
-                                                         _amount(c.amount, c.unit), f"{c.file}:{c.line}" if c.line
-                                                         else c.file)) + " |" for c in diff.changes]
-            out.append("")
-        if diff.displacements:
-            out += [f"End effectors moved (home pose and {samples} samples, seed {seed}):", "",
-                    "| " + " | ".join(KINEMATIC_COLUMNS) + " |", "|" + " --- |" * len(KINEMATIC_COLUMNS)]
-            out += ["| " + " | ".join(_cell(v) for v in _kinematic_row(moved)) + " |" for moved in diff.displacements]
-            out.append("")
-        if diff.findings:
-            out += ["| lint | rule | severity | message |", "| --- | --- | --- | --- |"]
-            out += [f"| {f.status} | {f.rule} | {f.severity} | {_cell(f.message)} |" for f in diff.findings]
-            out.append("")
-        out += [f"_{_cell(note)}_" for note in diff.notes]
+        for intro, table in _tables(diff, samples, seed):
+            out += [markdown_text(intro), ""] if intro else []
+            out += table_markdown(table, code_columns=("at",))
+        out += [f"_{markdown_text(note)}_" for note in diff.notes]
     return "\n".join(out).rstrip("\n") + "\n"
 
 
 def annotations(diffs: Sequence[RobotDiff]) -> str:
     """``::warning file=F,line=L,title=ar3cli diff::...`` per change and moved end effector, ``::notice``
-    per lint finding that came or went. Changes located only in a revision (``REV:path``) get no file."""
-    from ar3cli.output.github_actions import escape_data, escape_property
+    per lint finding that came or went (at most the output layer's annotations per run). Changes
+    located only in a revision (``REV:path``) get no file."""
+    from ar3cli.output.github_actions import capped_annotations, workflow_command
 
     def line(kind: str, file: str, number: int, title: str, message: str) -> str:
-        properties = [f"file={escape_property(file)}"] if file and ":" not in file else []
-        if properties and number:
-            properties.append(f"line={number}")
-        properties.append(f"title={escape_property(title)}")
-        return f"::{kind} {','.join(properties)}::{escape_data(message)}"
+        return workflow_command(kind, message, file=file if file and ":" not in file else "", line=number, title=title)
 
     out = []
     for diff in diffs:
@@ -113,4 +114,4 @@ def annotations(diffs: Sequence[RobotDiff]) -> str:
                      f"link '{m.link}' moved {show(m.home_m)} m, {show(m.home_rad)} rad at home (max {show(m.max_m)} m, "
                      f"{show(m.max_rad)} rad over the samples); cause: {m.cause}") for m in diff.displacements]
         out += [line("notice", f.file, f.line, f"ar3cli diff: lint {f.rule} {f.status}", f.message) for f in diff.findings]
-    return "".join(text + "\n" for text in out)
+    return capped_annotations(out, "changes")

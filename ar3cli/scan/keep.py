@@ -5,7 +5,7 @@ and case does not matter (``'no errors'`` is ``no-errors``):
 
 ========================  =======================================================================
 ``loads``                 the file loaded and its check finished (status clean or findings)
-``clean``                 no finding at all
+``clean``                 loads, and no finding at or above ``error`` (as lint-urdf's summary counts clean files)
 ``no-errors``             loads, and no error finding
 ``no-warnings``           loads, and no error or warning finding
 ``max-severity=LEVEL``    loads, and no finding above LEVEL (``info``, ``warning`` or ``error``)

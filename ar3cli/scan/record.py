@@ -2,8 +2,9 @@
 
 Statuses, worst last in :data:`STATUSES`:
 
-- ``clean``: loaded and checked, no finding;
-- ``findings``: loaded and checked, at least one finding;
+- ``clean``: loaded and checked, no finding at or above :data:`FAIL_ON` (what ``lint-urdf``'s
+  summary calls clean with its default ``--fail-on``: a file with only warnings or info passes);
+- ``findings``: loaded and checked, at least one finding at or above :data:`FAIL_ON`;
 - ``error``: not loaded (its F001-F004 finding says why) or the check failed inside ar3cli;
 - ``crash``: a crash in C code cut the check short (pybullet under ``--sim``, or the worker died);
 - ``timeout``: the check took longer than the per-file limit and was stopped.
@@ -20,6 +21,8 @@ STATUSES = ("clean", "findings", "error", "crash", "timeout")
 LOADED = ("clean", "findings")
 """Statuses of a file that loaded and whose check ran to the end."""
 SEVERITIES = ("info", "warning", "error")
+FAIL_ON = "error"
+"""The severity from which a finding makes a file not clean: lint-urdf's default ``--fail-on``."""
 
 JOINT_DOF = {"revolute": 1, "continuous": 1, "prismatic": 1, "planar": 3, "floating": 6, "spherical": 3}
 """Degrees of freedom per joint type, as ``ar3cli info`` counts them (a mimic joint adds none)."""
@@ -79,7 +82,13 @@ def status_of(loaded: bool, findings: list, error: str | None) -> str:
         return "crash"
     if not loaded:
         return "error"
-    return "findings" if findings else "clean"
+    return "clean" if clean(findings) else "findings"
+
+
+def clean(findings: list[dict[str, Any]]) -> bool:
+    """No finding at or above :data:`FAIL_ON` (``findings`` are :meth:`Finding.to_dict` dictionaries)."""
+    failing = SEVERITIES[SEVERITIES.index(FAIL_ON):]
+    return not any(finding["severity"] in failing for finding in findings)
 
 
 def severity_rank(row: Row) -> tuple:

@@ -26,7 +26,7 @@ def summarize(rows: list[Row], filters: list[Keep], top: int) -> dict[str, Any]:
         files.update(set(codes))
         for f in row.findings:
             severity.setdefault(f["rule"], f["severity"])
-    worst = sorted((row for row in rows if row.status != "clean"), key=severity_rank, reverse=True)[:top]
+    worst = sorted((row for row in rows if row.status != "clean" or row.findings), key=severity_rank, reverse=True)[:top]
     keep = kept(rows, filters)
     return {
         "files": len(rows),
@@ -66,17 +66,9 @@ def keep_line(data: dict[str, Any]) -> str:
 
 
 def markdown(data: dict[str, Any]) -> str:
-    """The tables as GitHub Markdown, then the keep line."""
-    out: list[str] = []
-    for table in tables(data):
-        out += [f"### {table.title}", "", "| " + " | ".join(table.columns) + " |",
-                "| " + " | ".join("---:" if c in table.numeric_columns else "---" for c in table.columns) + " |"]
-        out += ["| " + " | ".join(_cell(value) for value in row) + " |" for row in table.rows]
-        out.append("")
-    return "\n".join([*out, keep_line(data)]) + "\n"
+    """The tables as GitHub Markdown, then the keep line (every cell escaped by the output layer)."""
+    from ar3cli.output.escape import markdown_text
+    from ar3cli.output.markdown_table import table_markdown
 
-
-def _cell(value: Any) -> str:
-    from ar3cli.output.report import printable
-
-    return printable(str(value)).replace("|", "\\|")
+    out = [line for table in tables(data) for line in table_markdown(table, code_columns=("path",))]
+    return "\n".join([*out, markdown_text(keep_line(data))]) + "\n"

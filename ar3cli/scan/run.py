@@ -20,7 +20,7 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.scan.record import STATUSES, Row
-from ar3cli.scan.store import Store
+from ar3cli.scan.store import Store, storable
 from ar3cli.scan.worker import ScanSettings, content_hash
 
 COMMIT_ROWS = 64
@@ -100,7 +100,7 @@ def _to_check(files: list[Path], known: dict[str, tuple[str, str]], key: str) ->
         if absolute in todo:
             continue
         sha = content_hash(absolute)
-        if known.get(absolute) != (sha, key):
+        if known.get(storable(absolute)) != (sha, key):
             todo[absolute] = sha
     return todo
 

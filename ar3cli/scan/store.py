@@ -16,7 +16,7 @@ from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from ar3cli.errors import UserError
-from ar3cli.scan.record import Row
+from ar3cli.scan.record import LOADED, Row, status_of
 
 SCHEMA_VERSION = 1
 _COLUMNS = ("path", "sha256", "settings", "status", "findings", "message", "dof", "mass", "links", "joints",
@@ -36,6 +36,21 @@ CREATE TABLE IF NOT EXISTS files (
 );
 CREATE INDEX IF NOT EXISTS files_status ON files(status);
 """
+
+
+def storable(text: str) -> str:
+    """``text`` as the store keeps it: a file name that is not UTF-8 (Python holds its bytes as lone
+    surrogates, which SQLite cannot take) with those bytes written ``\\xff``, as ar3cli shows them;
+    every other text as it is."""
+    try:
+        text.encode("utf-8")
+        return text
+    except UnicodeEncodeError:
+        pass
+    try:
+        return text.encode("utf-8", "surrogateescape").decode("utf-8", "backslashreplace")
+    except UnicodeEncodeError:  # a surrogate that is no file-name byte
+        return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
 class Store:
@@ -73,7 +88,8 @@ class Store:
 
     def put(self, rows: Iterable[Row], now: float) -> int:
         """Write ``rows`` in one transaction (all or none); a row replaces the one with its path."""
-        values = [(row.path, row.sha256, row.settings, row.status, row.findings_json(), row.message, row.dof,
+        values = [(storable(row.path), row.sha256, row.settings, row.status, row.findings_json(), storable(row.message),
+                   row.dof,
                    row.mass, row.links, row.joints, row.load_seconds, row.check_seconds,
                    *(row.counts()[level] for level in ("error", "warning", "info")), now) for row in rows]
         marks = ", ".join("?" * len(_COLUMNS))
@@ -86,7 +102,10 @@ class Store:
         query = f"SELECT {', '.join(_COLUMNS[:12])} FROM files ORDER BY path"
         try:
             for record in self.db.execute(query):
-                yield Row(*record[:4], json.loads(record[4]), *record[5:])  # type: ignore[arg-type]
+                row = Row(*record[:4], json.loads(record[4]), *record[5:])  # type: ignore[arg-type]
+                if row.status in LOADED:  # a store written when "clean" meant no finding at all reads as today
+                    row.status = status_of(True, row.findings, None)
+                yield row
         except sqlite3.DatabaseError as exc:
             raise UserError(f"{self.path}: cannot read the scan store ({exc})") from None
 

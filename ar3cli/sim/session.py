@@ -33,6 +33,7 @@ from __future__ import annotations
 import contextlib
 import itertools
 import math
+import re
 import tempfile
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -40,6 +41,7 @@ from pathlib import Path
 from typing import Any, TypeVar
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.infra.isolation import report_stage
 from ar3cli.sim.capture import capture_fds
 from ar3cli.sim.loadable_copy import LineMap, user_lines
@@ -378,7 +380,9 @@ class Session:
         """Write the copy pybullet loads (:mod:`ar3cli.sim.loadable_copy`) under a fresh name, filling ``lines``."""
         from ar3cli.sim.loadable_copy import write_loadable_copy
 
-        name = f"{next(_load_counter)}_{model.path.stem.replace('.urdf', '')}.urdf"
+        # only safe characters: pybullet takes a UTF-8 path, and a file name need not be UTF-8 (byte 0xff)
+        stem = re.sub(r"[^A-Za-z0-9_.-]", "_", model.path.stem.replace(".urdf", ""))
+        name = f"{next(_load_counter)}_{stem}.urdf"
         return write_loadable_copy(model, Path(self._tmp.name) / name, visuals, lines)
 
     def step(self, count: int = 1) -> None:
@@ -422,9 +426,8 @@ def run_pybullet(work: Callable[[], Result], model: Model, timeout: float | None
 
 def _listing(names: Sequence[str], most: int = 5) -> str:
     """``link 'a'`` / ``links 'a', 'b' and 3 more``."""
-    shown = ", ".join(f"'{name}'" for name in names[:most])
-    more = f" and {len(names) - most} more" if len(names) > most else ""
-    return f"link{'s' if len(names) > 1 else ''} {shown}{more}"
+    shown = listed((f"'{name}'" for name in names), most)
+    return f"link{'s' if len(names) > 1 else ''} {shown}"
 
 
 def known_crash_cause(model: Model) -> str | None:
@@ -435,7 +438,7 @@ def known_crash_cause(model: Model) -> str | None:
             parents.setdefault(joint.child, []).append(joint)
     for link, joints in parents.items():
         if len(joints) > 1:
-            names = ", ".join(f"'{joint.name}' (line {joint.line})" for joint in joints)
+            names = listed(f"'{joint.name}' (line {joint.line})" for joint in joints)
             return (f"link '{link}' is the child of {len(joints)} joints ({names}), which crashes pybullet: "
                     "keep one of them")
     return None

@@ -11,6 +11,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Model
 
 
@@ -26,7 +27,7 @@ def driven_values(model: Model, positions: Mapping[str, np.ndarray], count: int)
             return values[joint.name]
         if joint.mimic is not None and model.joint(joint.mimic.joint) is not None:
             if joint.name in seen:
-                raise UserError(f"mimic joints form a cycle: {' -> '.join((*seen, joint.name))}")
+                raise UserError(f"mimic joints form a cycle: {listed((*seen, joint.name), separator=' -> ')}")
             source = value_of(model.joint(joint.mimic.joint), (*seen, joint.name))  # type: ignore[arg-type]
             result = joint.mimic.multiplier * source + joint.mimic.offset
         else:

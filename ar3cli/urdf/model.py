@@ -18,6 +18,7 @@ from pathlib import Path
 from typing import Any
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 from ar3cli.infra.safe_read import read_bytes
 from ar3cli.maths.tensor_math import matrix_to_rpy, quaternion_to_matrix, rpy_to_matrix, unit_quaternion
 from ar3cli.urdf import xmlsource
@@ -333,7 +334,7 @@ class Model:
         """The single root link; raises UserError when the tree has none or several."""
         roots = self.root_links()
         if len(roots) != 1:
-            names = ", ".join(link.name for link in roots) or "none"
+            names = listed(link.name for link in roots) or "none"
             raise UserError(f"{self.path}: expected one root link, found {len(roots)} ({names}); "
                             "run ar3cli lint-urdf for details")
         return roots[0]

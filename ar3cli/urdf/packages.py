@@ -24,6 +24,7 @@ from functools import cached_property, lru_cache
 from pathlib import Path
 from urllib.parse import unquote
 
+from ar3cli.findings import listed
 from ar3cli.infra.file_cache import PathState, path_state
 
 _PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
@@ -50,7 +51,7 @@ class Resolution:
             return f"{self.uri} -> {self.path}"
         reason = self.problem or "not found"
         if self.tried:
-            return f"{self.uri}: {reason}; tried {', '.join(self.tried)}"
+            return f"{self.uri}: {reason}; tried {listed(self.tried)}"
         return f"{self.uri}: {reason}"
 
 

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.findings import listed
 
 _DECLARATION = re.compile(rb"<\?xml[^>]*\?>")
 _VERSION_ATTR = re.compile(rb"""version\s*=\s*(["'])([^"']*)\1""")
@@ -159,7 +160,7 @@ def _declare_undeclared_prefixes(data: bytes, quirks: list[Quirk]) -> bytes:
     root = _ROOT_TAG.search(data)
     if not missing or root is None:
         return data
-    names = ", ".join(prefix.decode("ascii", "replace") for prefix in missing)
+    names = listed(prefix.decode("ascii", "replace") for prefix in missing)
     line = data.count(b"\n", 0, min(first_use[prefix] for prefix in missing)) + 1
     quirks.append(Quirk("undeclared-prefix", f"namespace prefix {names} is used but never declared (xmlns:...): "
                                              "PyBullet and urdfdom read the file, namespace-aware XML tools "

@@ -5,6 +5,7 @@ from __future__ import annotations
 from collections import Counter
 from collections.abc import Iterator
 
+from ar3cli.findings import listed
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
 from ar3cli.urdf.model import URDF_JOINT_TYPES
 
@@ -102,7 +103,7 @@ def several_roots(ctx) -> Iterator[Hit]:
     connected = {j.parent for j in ctx.model.joints} | {j.child for j in ctx.model.joints}
     # The first root that has children is the real one; report the others.
     main = next((link for link in roots if link.name in connected), roots[0])
-    names = ", ".join(link.name for link in roots)
+    names = listed(link.name for link in roots)  # once for all: a message per root naming all of them is quadratic
     for link in roots:
         if link is main:
             continue
@@ -131,7 +132,7 @@ def not_a_tree(ctx) -> Iterator[Hit]:
             parents.setdefault(joint.child, []).append(joint)
     for child, joints in parents.items():
         for joint in joints[1:]:
-            yield Hit(f"link '{child}' has {len(joints)} parent joints ({', '.join(j.name for j in joints)}); "
+            yield Hit(f"link '{child}' has {len(joints)} parent joints ({listed(j.name for j in joints)}); "
                       f"joint '{joint.name}' is one too many", joint.element)
     # Cycles: follow the first parent joint upwards from every link, stopping at a link an earlier
     # walk already went through (its way up is known), so every link is walked once: linear in the
@@ -152,7 +153,7 @@ def not_a_tree(ctx) -> Iterator[Hit]:
             if key not in reported:
                 reported.add(key)
                 joint = parent_of[key]
-                yield Hit(f"joints form a cycle through links {' -> '.join(loop)} -> {link}", joint.element)
+                yield Hit(f"joints form a cycle through links {listed([*loop, link], separator=' -> ')}", joint.element)
 
 
 @rule("S007", "unknown-joint-reference", "error", "Reference to a joint or link that does not exist",
@@ -374,7 +375,7 @@ def duplicate_element(ctx) -> Iterator[Hit]:
     for geometry in ctx.model.root.iter("geometry"):
         shapes = [child for child in geometry if isinstance(child.tag, str)]
         if len(shapes) > 1:
-            yield Hit(f"{_owner_name(geometry)} has {len(shapes)} children ({', '.join(child.tag for child in shapes)}): "
+            yield Hit(f"{_owner_name(geometry)} has {len(shapes)} children ({listed(child.tag for child in shapes)}): "
                       "parsers read the first as the shape and ignore the rest", shapes[1])
 
 

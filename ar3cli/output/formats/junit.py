@@ -12,7 +12,8 @@ def lint_junit(lint: LintReport) -> Report:
     """The JUnit document on stdout, the verdict on stderr."""
     from ar3cli.output.junit import junit_document
 
-    document = junit_document([(r.path, r.findings, r.error) for r in lint.results], Severity(lint.summary["fail_on"]))
+    document = junit_document([(r.path, r.findings, r.error) for r in lint.results], Severity(lint.summary["fail_on"]),
+                              lint.group is not None)
     return completed(lint, Report(data=lint.data, text=document, lines=[summary_line(lint.summary)], ok=lint.ok))
 
 

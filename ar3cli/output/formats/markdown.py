@@ -10,11 +10,11 @@ from ar3cli.output.report import Report
 
 
 def lint_markdown(lint: LintReport) -> Report:
-    """The findings as a Markdown table, then the verdict."""
-    from ar3cli.output.markdown_table import markdown_table
+    """The findings as a Markdown table (a row per rule and file, errors first), then the verdict."""
+    from ar3cli.output.markdown_table import findings_markdown
 
-    return completed(lint, Report(data=lint.data, text=markdown_table(lint.findings, summary_line(lint.summary)),
-                                  ok=lint.ok))
+    text = findings_markdown(lint.findings, summary_line(lint.summary), lint.group is not None)
+    return completed(lint, Report(data=lint.data, text=text, ok=lint.ok))
 
 
 def markdown(report: Report) -> Report:

@@ -11,7 +11,7 @@ def lint_sarif(lint: LintReport) -> Report:
     """The SARIF document of the findings and the rules that ran."""
     from ar3cli.output.sarif import sarif_document
 
-    return completed(lint, Report(data=sarif_document(lint.findings, lint.rules()), ok=lint.ok))
+    return completed(lint, Report(data=sarif_document(lint.findings, lint.rules(), lint.group is not None), ok=lint.ok))
 
 
 FORMAT = register(Format("sarif", "SARIF 2.1.0", {LINT: lint_sarif}, stream=OutputFormat.json, order=20))
