@@ -165,6 +165,11 @@ NO_ROBOT_INPUT = {
     "grasp-demo": "runs the bundled AR3 and a cube: reads no robot file",
 }
 """Commands that read no robot file (no argument): nothing of an attacker's reaches their output."""
+FRONT_ENDS = {
+    "server": ("tests/test_server.py", "test_hostile_names_reach_the_editor_as_plain_text"),
+}
+"""Commands without ``--format`` that read robot files another way (an editor's buffers over LSP, a
+browser): the test named here walks their output with the same hostile names."""
 
 
 def _commands() -> dict[str, object]:
@@ -187,7 +192,9 @@ def test_every_command_is_walked_or_reads_no_robot_file(workspace):
     from ar3cli.cli import COMMANDS as NAMES
 
     walked = set(arguments(workspace))
-    assert walked | set(NO_ROBOT_INPUT) == set(NAMES), "say how to run a new command in arguments()"
+    assert walked | set(NO_ROBOT_INPUT) | set(FRONT_ENDS) == set(NAMES), "say how to run a new command in arguments()"
+    for module, test in FRONT_ENDS.values():
+        assert f"def {test}(" in (REPO / module).read_text(), (module, test)
     for name in NO_ROBOT_INPUT:
         assert not [param for param in COMMANDS[name].params if param.param_type_name == "argument"], name
 

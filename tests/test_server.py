@@ -272,3 +272,32 @@ async def test_sim_setting_adds_the_pybullet_rules_on_save(client: LanguageClien
     found = await diagnostics(client, uri, lambda found: "P005" in codes(found))
     assert "P003" not in codes(found)  # ignored by the workspace's configuration, as lint-urdf --sim does
     client.workspace_did_change_configuration(types.DidChangeConfigurationParams({"ar3cli": {"sim": False}}))
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_hostile_names_reach_the_editor_as_plain_text(client: LanguageClient, workspace: Path):
+    """The output boundary (issue 34) for the editor: a robot whose link and joint names hold a newline
+    with a workflow command, ESC, C1, a bidi override and Markdown gets diagnostics, hovers and an
+    outline that carry none of those characters raw, and hovers are plain text (no Markdown to render)."""
+    from tests.test_output_boundary import RAW, robot
+
+    path = workspace / "hostile.urdf"
+    path.write_text(robot())
+    uri = open_file(client, path)
+    found = await diagnostics(client, uri, lambda found: "J008" in codes(found))
+    outline = await client.text_document_document_symbol_async(types.DocumentSymbolParams(
+        types.TextDocumentIdentifier(uri)))
+    names = []
+    stack = list(outline or [])
+    while stack:
+        symbol = stack.pop()
+        names.append(symbol.name)
+        stack += symbol.children or []
+    line = next(number for number, text in enumerate(path.read_text().splitlines()) if "<child link=" in text)
+    hover = await client.text_document_hover_async(types.HoverParams(types.TextDocumentIdentifier(uri),
+                                                                     types.Position(line, 60)))
+    shown = [item.message for item in found] + names + ([hover.contents.value] if hover else [])
+    assert hover is None or hover.contents.kind == types.MarkupKind.PlainText
+    assert len(names) >= 3 and any("::error file=x::" in name for name in names)  # the names are there, escaped
+    for text in shown:
+        assert not any(character in text for character in RAW), repr(text)
