@@ -32,6 +32,16 @@ def test_cross_check_names_the_mimic_joint_and_the_engine_that_enforces_it():
     assert "PyBullet ignores it" in diagnosis and "line 38" in diagnosis
 
 
+def test_cross_check_holds_the_joints_nothing_couples():
+    """The reaction of a mimic constraint turns a light arm in MuJoCo (ERD's panda: panda_joint6 when
+    panda_finger_joint1 moves): the probe holds every joint without <mimic>, so no undiagnosed row is left."""
+    result = run("cross-check", str(DATA / "gripper_arm_light.urdf"), "-n", "1", "--format", "json")
+    data = json.loads(result.stdout)
+    constraint = [row for row in data["rows"] if row["quantity"].startswith("constraint")]
+    assert [row["where"] for row in constraint] == ["'finger_right_joint' when 'finger_left_joint' moves +0.005"]
+    assert all(row["diagnosis"] for row in data["rows"]), data["rows"]
+
+
 def test_cross_check_agrees_without_the_mimic():
     result = run("cross-check", str(FREE), "-n", "2", "--seed", "3")
     assert result.returncode == 0, result.stdout + result.stderr
