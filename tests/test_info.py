@@ -301,3 +301,12 @@ def test_info_says_what_pybullet_weighs(cli, session):
     assert data["pybullet_mass_kg"] == {"floating": pytest.approx(20.0), "fixed_base": pytest.approx(19.0)}
     text = cli("info", str(path)).stdout
     assert "PyBullet simulates 20 kg floating, 19 kg with a fixed base" in text
+
+
+def test_an_srdf_is_one_line_not_empty_tables(cli):
+    path = Path(__file__).parent / "data" / "srdf" / "ar3.srdf"
+    result = cli("info", str(path))
+    assert result.code == 2 and result.stdout == ""
+    assert result.stderr.strip() == (f"ar3cli: error: {path}: is an SRDF (MoveIt's semantic description: <group>, no "
+                                     "<link>), not a URDF; give the URDF it describes (sample-collisions "
+                                     "--srdf-compare reads an SRDF)")
