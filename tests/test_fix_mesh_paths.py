@@ -96,6 +96,25 @@ def test_every_kind_rewritten_and_outside_reported(cli, tree):
     assert cli("fix-mesh-paths", str(path), "--package", package, "--check").code == 0
 
 
+def test_a_uri_only_pybullet_finds_is_rewritten_as_g009_says(cli, tmp_path):
+    """``package://meshes/cube.obj`` next to the URDF: 'meshes' is no package, only PyBullet's fallback
+    search finds it (G009); the hint names fix-mesh-paths and the package it cannot find, and the fix works."""
+    (tmp_path / "my_pkg" / "meshes").mkdir(parents=True)
+    (tmp_path / "my_pkg" / "meshes" / "cube.obj").write_text(CUBE_OBJ)
+    path = tmp_path / "my_pkg" / "robot.urdf"
+    path.write_text(f'<robot name="m"><link name="base">{INERTIAL}<visual><geometry>'
+                    '<mesh filename="package://meshes/cube.obj"/></geometry></visual></link></robot>\n')
+    (finding,) = lint_findings(cli, path, "G009")
+    assert "'meshes' is no package ROS can find: ar3cli fix-mesh-paths --package PKG=DIR" in finding["hint"]
+    assert "NAME" not in finding["hint"]
+    package = f"my_pkg={path.parent}"
+    result = cli("fix-mesh-paths", str(path), "--package", package, "--format", "json")
+    assert result.code == 0, result.stdout + result.stderr
+    (change,) = json.loads(result.stdout)["files"][0]["changes"]
+    assert change["new"] == "package://my_pkg/meshes/cube.obj"
+    assert lint_findings(cli, path, "G001,G009", "--package-path", package) == []
+
+
 def test_diff_check_and_unresolvable(cli, tree):
     path, text = tree
     broken = text.replace("../meshes/arm.obj", "../meshes/missing.obj")

@@ -190,7 +190,8 @@ def no_collision(ctx) -> Iterator[Hit]:
       why="""The mesh resolves only because PyBullet also looks for package://NAME/x relative to the
       URDF and in every folder above it. ROS (RViz, MoveIt, Gazebo) resolves package://NAME through
       the package index and will not find it.""",
-      fix="Use a path relative to the URDF, or make NAME a real package (a package.xml) or pass --package-path.",
+      fix="ar3cli fix-mesh-paths --package PKG=DIR rewrites the URI to package://PKG/... (PKG your package, DIR its "
+          "folder); or use a path relative to the URDF.",
       bad=_mesh_robot("package://meshes/base.stl"), good=_mesh_robot("meshes/base.stl"))
 def pybullet_only_path(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
@@ -198,7 +199,10 @@ def pybullet_only_path(ctx) -> Iterator[Hit]:
         if resolution is not None and resolution.found and resolution.via == "pybullet-search" and \
                 not geometry.filename.strip().startswith("package:///"):  # G002's (an error already)
             yield Hit(f"link '{link.name}' mesh {resolution.uri} is found only by PyBullet's fallback search; "
-                      "ROS tools will not find it", geometry.element)
+                      "ROS tools will not find it", geometry.element,
+                      hint=f"'{resolution.uri.split('/')[2]}' is no package ROS can find: ar3cli fix-mesh-paths --package "
+                           "PKG=DIR rewrites the URI to package://PKG/... (PKG your package, DIR its folder), or use a "
+                           "path relative to the URDF.")
 
 
 SPEC_SHAPES = ("box", "cylinder", "sphere", "mesh")
