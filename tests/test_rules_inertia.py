@@ -90,6 +90,7 @@ def test_world_inertial_and_root_without_inertial(tmp_path):
         <joint name="j" type="fixed"><parent link="base_link"/><child link="chassis"/></joint>""")
     (frame,) = codes_for(write_fixture(tmp_path, frame_root), "I012")
     assert "is a frame (no geometry)" in frame.message and "1 kg" in frame.message and "tiny <inertial>" in frame.hint
+    assert codes_for(write_fixture(tmp_path, arm()), "I012") == []  # an arm turning on its mounting frame
     (finding,) = codes_for(write_fixture(tmp_path, REGISTRY["I012"].bad), "I012")
     assert "if this robot floats" in finding.message and "fix-inertia --links chassis" in finding.hint
 

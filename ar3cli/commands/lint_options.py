@@ -47,9 +47,9 @@ SimOption = Annotated[bool, typer.Option(
     "--sim", help="Also load each model in PyBullet (P rules): load errors, self-collision at home, inertia "
                   "PyBullet really uses, stability.")]
 EngineOption = Annotated[Engine, typer.Option(
-    "--engine", help="With --sim: the simulator(s) to check in: PyBullet (P rules), MuJoCo (M rules: compile, "
+    "--engine", help="The simulator(s) --sim checks in: PyBullet (P rules), MuJoCo (M rules: compile, "
                      "unreadable meshes, contacts at home, 1 s under gravity; needs pip install 'ar3cli[mujoco]'), "
-                     "or all.")]
+                     "or all; mujoco and all imply --sim.")]
 NoConfigOption = Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
 JobsOption = Annotated[Optional[int], typer.Option(
     "--jobs", "-j", min=1, show_default=False,

@@ -99,8 +99,7 @@ def lint_urdf(
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_args import parse_xacro_args
 
-    if Engine(engine) is not Engine.pybullet and not sim:
-        raise UserError("--engine chooses the simulator of --sim: add --sim")
+    sim = sim or Engine(engine) is not Engine.pybullet  # --engine mujoco|all asks for a simulation
     engines = ("pybullet", "mujoco") if engine is Engine.all else (Engine(engine).value,)
     if sim and "mujoco" in engines:
         from ar3cli.sim.mujoco_session import import_mujoco

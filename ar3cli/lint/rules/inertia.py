@@ -351,13 +351,15 @@ def world_inertial(ctx) -> Iterator[Hit]:
       useFixedBase=False, PyBullet gives a root without <inertial> 1 kg and I = (1, 1, 1), silently
       apart from a C-level warning; Drake makes it a massless free body, whose dynamics are
       singular. (MuJoCo's URDF import fixes the root to the world whatever its mass.)
-      A root without geometry (base_link, base_footprint: a frame by ROS convention, where KDL
-      wants no inertia) weighs 1 kg in PyBullet too; only a root named world gets 0.""",
+      A root without geometry weighs 1 kg in PyBullet too (only one named world gets 0): a frame fixed
+      on top of a body (base_footprint, Jackal's base_link over its chassis) is reported, as the body
+      under it is most likely a mobile base; a frame an arm turns on (a moving joint) is not.""",
       fix="If the robot floats, give the root link its real <inertial> (ar3cli fix-inertia --links ROOT computes one "
           "from the geometry); if it is always fixed to the world, nothing to do.",
       bad=robot('''<link name="chassis"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
       good=robot(f'''<link name="chassis">{LINK_INERTIAL}<collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
-      thresholds="A root named world is skipped: PyBullet gives it mass 0.",
+      thresholds="Skipped: a root named world (PyBullet gives it mass 0), and a root without geometry that "
+                 "is not joined to the rest by fixed joints only (an arm's mounting frame).",
       references="PyBullet UrdfParser.cpp parseLink (mass 1, inertia 1 without <inertial>); Drake "
                  "multibody/parsing/detail_urdf_parser.cc ParseBody (no <inertial>: zero spatial inertia).")
 def root_inertial_missing(ctx) -> Iterator[Hit]:
@@ -365,7 +367,9 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
     if len(roots) != 1:
         return  # no root or several: S005's business
     root = roots[0]
-    if root.inertial is None and root.name != "world":
+    below = [joint.type for joint in ctx.model.joints if joint.parent == root.name]
+    frame_on_a_body = bool(below) and all(kind == "fixed" for kind in below)
+    if root.inertial is None and root.name != "world" and (root.has_geometry or frame_on_a_body):
         what = "has geometry but" if root.has_geometry else "is a frame (no geometry) with"
         fix = (f"ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write the real <inertial>)"
                if root.has_geometry else "give it a tiny <inertial> (mass 1e-6 kg, I = 1e-12)")
