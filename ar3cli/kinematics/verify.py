@@ -166,8 +166,9 @@ def fk_report(model: Model, path: Path, samples: int, seed: int, tolerance: Tole
           "pass" if tolerance.link_passes(e) else "fail"] for e in links],
         caption="pybullet reports link frames in single precision: ~1e-7 m / ~6e-7 rad is its floor")
     lines = [f"note: {note}" for note in comparison.notes] + (dh.lines if dh else [])
-    lines.append(f"worst link: {worst.link} (sample {worst.worst_sample}: "
-                 f"{_configuration(drawn.configuration(worst.worst_sample))})")
+    worst_at = drawn.configuration(worst.worst_sample)
+    lines.append(f"worst link: {worst.link} " + (f"(sample {worst.worst_sample}: {_configuration(worst_at)})" if worst_at
+                                                 else "(no movable joint: every sample is the same configuration)"))
     scaled = (f", up to {largest:.3g} m at {max(e.max_reach for e in links):.3g} m reach"
               if largest > tolerance.position else "")
     lines.append(f"{'PASS' if passed else 'FAIL'}: max position error {max_position:.3g} m (tolerance "
