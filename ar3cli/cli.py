@@ -58,6 +58,7 @@ COMMANDS: dict[str, str] = {
     "render": "ar3cli.commands.render:render_command",
     "fk-verify": "ar3cli.commands.fk_verify:fk_verify",
     "lint-urdf": "ar3cli.commands.lint_urdf:lint_urdf",
+    "expand": "ar3cli.commands.expand:expand",
     "grasp-demo": "ar3cli.commands.grasp_demo:grasp_demo",
     **_fixer_commands(),
     "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",

@@ -134,6 +134,10 @@ def plan_mesh_paths(model, document: Document, options: MeshPathOptions) -> FixP
                                                      f"--package-path {name}={options.packages[name]} (got {got}); "
                                                      "left as it is"))
             continue
+        refused = document.refusal(element, ("filename",), same_for_every_use=True)
+        if refused is not None:
+            plan.skipped.append(Skipped(where, line, refused))
+            continue
         document.set_attribute(document.span(element), "filename", new)
         plan.changes.append(Change(where, line, f"{element.tag} filename", uri, new,
                                    f"{kind} path, file under --package {name}"))
@@ -246,7 +250,7 @@ def _real(name: bytes) -> str:
 
 
 FIXER = Fixer[MeshPathOptions]("fix-mesh-paths", plan_mesh_paths, verify, options=MeshPathOptions,
-                                timeout=DEFAULT_TIMEOUT_S, session=with_packages, help="""\
+                                timeout=DEFAULT_TIMEOUT_S, session=with_packages, edits_xacro=True, help="""\
 Rewrite machine-bound mesh and texture URIs to `package://NAME/...`, byte for byte, atomically.
 
 Absolute paths, `file://` URIs, `package:///` URIs (no package name), paths relative to the

@@ -386,9 +386,11 @@ def load_model(
     """Read, expand (xacro), parse and index one robot file; bad input raises :class:`UserError`.
 
     ``source`` stands in for the file's bytes (a fixer's result, checked before anything is
-    written); ``path`` still says where relative mesh paths start.
+    written; xacro expanded from it); ``path`` still says where relative mesh paths and included
+    files start.
     """
     path = Path(path)
+    given = source
     source = read_bytes(path) if source is None else source
     if not source.strip(b"\x00 \t\r\n"):
         raise UserError(f"{path}: file is empty")
@@ -399,7 +401,7 @@ def load_model(
         from ar3cli.urdf.xacro_expand import expand
 
         _, quirks = xmlsource.normalize(source)
-        xml_bytes = expand(path, dict(xacro_args or {}), resolver)
+        xml_bytes = expand(path, dict(xacro_args or {}), resolver, source=given)
         xmlsource.refuse_entities(xml_bytes, path)  # an included file may declare some
     else:
         xml_bytes, quirks = xmlsource.normalize(source)

@@ -86,9 +86,10 @@ class _Expansion(NamedTuple):
     notes: list[str]
 
 
-def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes:
+def expand(path: Path, args: dict[str, str], resolver: PackageResolver, source: bytes | None = None) -> bytes:
     """Return the expanded URDF as UTF-8 bytes (and keep its elements' :func:`origins` and
-    :func:`included_files`).
+    :func:`included_files`). ``source`` stands in for the bytes of ``path`` itself (a fixer's result,
+    checked before it is written); the files it includes are read from disk as usual.
 
     The expansion runs in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`) with CPU,
     memory and wall-clock limits, under the current policy (safe mode by default,
@@ -104,7 +105,7 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
     def work() -> _Expansion:
         if os.getpid() != parent:  # in the child (where fork is missing, the work runs here: no limits)
             _limit_this_process()
-        return _expand_here(path, args, resolver, policy)
+        return _expand_here(path, args, resolver, policy, source)
 
     try:
         result = run_isolated(work, str(path))
@@ -145,7 +146,8 @@ def _limit_this_process() -> None:
         resource.setrlimit(resource.RLIMIT_AS, (wanted if hard == resource.RLIM_INFINITY else min(wanted, hard), hard))
 
 
-def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, policy: XacroPolicy) -> _Expansion:
+def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, policy: XacroPolicy,
+                 source: bytes | None = None) -> _Expansion:
     """The expansion itself, in this process.
 
     xacro keeps module-level state and prints diagnostics with ``print``; both are contained
@@ -173,7 +175,8 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
     kept: dict = {}
     original_find, original_parse = substitution_args._eval_find, xacro.parse
     substitution_args._eval_find = find_package
-    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots)
+    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots,
+                                      {str(path): source} if source is not None else {})
     chatter = io.StringIO()
     included_before = len(xacro.all_includes)
     try:
@@ -302,7 +305,8 @@ def _arguments_hint(path: Path, given: dict[str, str]) -> str:
     return f"; the file takes xacro arguments ({shown}): pass the ones it needs with --xacro-arg NAME:=VALUE"
 
 
-def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None):
+def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None,
+                        sources: dict[str, bytes] | None = None):
     """xacro's ``parse(inp, filename)``, noting the origin of each element read from a file.
 
     The file is read as xacro reads it (text, default encoding) and parsed by the builder
@@ -313,6 +317,7 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
     xacro to evaluate: 3 ms less on the AR3). xacro's own elements are left alone (xacro checks
     their attributes); inside ``xacro:if``/``xacro:unless`` nodes are moved, never copied.
     With ``roots`` (safe mode), an existing file is read only inside them, through the capped reader.
+    ``sources`` maps a file name as xacro names it to the bytes that stand in for the file.
     """
     import locale
     from xml.dom import expatbuilder
@@ -354,6 +359,8 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
         if inp is not None or filename is None:
             return original_parse(inp, filename)
         full = os.path.join(getattr(xacro, "root_dir", os.curdir), filename)
+        if sources and str(filename) in sources:
+            return Builder(str(filename)).parseString(sources[str(filename)].decode("utf-8", "replace"))
         if roots is not None and os.path.lexists(full):
             text = read_inside(roots, full).decode(locale.getpreferredencoding(False))  # as open() decodes
             return Builder(str(filename)).parseString(text)
