@@ -107,6 +107,9 @@ def test_an_interrupted_scan_resumes_with_no_file_lost_or_doubled(tmp_path: Path
     assert process.returncode == (130 if how is signal.SIGINT else -signal.SIGKILL), err
     partial = len(stored(store))
     assert 0 < partial < 40
+    if how is signal.SIGINT:  # it says what is stored and how to go on
+        assert f"files checked in this run; {partial} files are stored in {store}" in err, err
+        assert "Run the same command again to go on" in err
 
     rerun = ar3cli("scan", str(tmp_path / "robots"), "--store", str(store), "-f", "json")
     assert rerun.returncode == 0, rerun.stderr

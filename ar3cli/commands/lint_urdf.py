@@ -100,6 +100,10 @@ def lint_urdf(
     from ar3cli.urdf.xacro_args import parse_xacro_args
 
     sim = sim or Engine(engine) is not Engine.pybullet  # --engine mujoco|all asks for a simulation
+    from ar3cli.infra.isolation import announce_slow_work
+    from ar3cli.output.report import log
+
+    announce_slow_work(lambda line: log(f"lint-urdf: {line}"))  # a humanoid's --sim takes ~7 s: say so on stderr
     engines = ("pybullet", "mujoco") if engine is Engine.all else (Engine(engine).value,)
     if sim and "mujoco" in engines:
         from ar3cli.sim.mujoco_session import import_mujoco
