@@ -113,6 +113,12 @@ def test_a_uri_only_pybullet_finds_is_rewritten_as_g009_says(cli, tmp_path):
     (change,) = json.loads(result.stdout)["files"][0]["changes"]
     assert change["new"] == "package://my_pkg/meshes/cube.obj"
     assert lint_findings(cli, path, "G001,G009", "--package-path", package) == []
+    below = tmp_path / "my_pkg" / "urdf" / "robot.urdf"  # a relative path PyBullet finds one folder up
+    below.parent.mkdir()
+    below.write_text(f'<robot name="m"><link name="base">{INERTIAL}<visual><geometry>'
+                     '<mesh filename="meshes/cube.obj"/></geometry></visual></link></robot>\n')
+    (relative,) = lint_findings(cli, below, "G009")
+    assert relative["hint"].startswith("the path is not there relative to the URDF")
 
 
 def test_diff_check_and_unresolvable(cli, tree):

@@ -200,9 +200,16 @@ def pybullet_only_path(ctx) -> Iterator[Hit]:
                 not geometry.filename.strip().startswith("package:///"):  # G002's (an error already)
             yield Hit(f"link '{link.name}' mesh {resolution.uri} is found only by PyBullet's fallback search; "
                       "ROS tools will not find it", geometry.element,
-                      hint=f"'{resolution.uri.split('/')[2]}' is no package ROS can find: ar3cli fix-mesh-paths --package "
-                           "PKG=DIR rewrites the URI to package://PKG/... (PKG your package, DIR its folder), or use a "
-                           "path relative to the URDF.")
+                      hint=_pybullet_only_hint(resolution.uri))
+
+
+def _pybullet_only_hint(uri: str) -> str:
+    """G009's hint for ``uri``: which package ROS cannot find (or that the relative path is not there), and the fix."""
+    package = uri.strip()[len("package://"):].split("/")[0] if uri.strip().startswith("package://") else ""
+    what = (f"'{package}' is no package ROS can find" if package else
+            "the path is not there relative to the URDF (PyBullet finds it in a folder above)")
+    return (f"{what}: ar3cli fix-mesh-paths --package PKG=DIR rewrites the URI to package://PKG/... (PKG your "
+            "package, DIR its folder).")
 
 
 SPEC_SHAPES = ("box", "cylinder", "sphere", "mesh")
