@@ -77,3 +77,10 @@ def test_lint_sim_still_says_pybullet_cannot_load_the_file_as_written(iiwa_witho
                  "--format", "json")
     rules = {finding["rule"] for finding in json.loads(result.stdout)["findings"]}
     assert {"P001", "G001"} <= rules
+
+
+def test_a_missing_cdf_geometry_is_left_out_too(pybullet_data_dir: Path, cli) -> None:
+    """pybullet_data's toys/concave_box.urdf names a concave_box.cdf that pybullet_data does not ship."""
+    result = cli("fk-verify", str(pybullet_data_dir / "toys" / "concave_box.urdf"), "--samples", "2")
+    assert result.code == 0, result.stderr
+    assert "cdf concave_box.cdf: file not found" in result.stderr

@@ -99,8 +99,9 @@ def drawable_visuals(model: Model) -> tuple[Model, list[str]]:
     from ar3cli.sim.loadable_copy import unloadable_mesh_reason, user_place
 
     def undrawable_reason(shape: Any) -> str | None:
-        mesh = shape.element.find("geometry/mesh")
-        return None if mesh is None else unloadable_mesh_reason(mesh, model.resolver)
+        geometry = shape.element.find("geometry")
+        reasons = (unloadable_mesh_reason(element, model.resolver) for element in (geometry if geometry is not None else ()))
+        return next((reason for reason in reasons if reason is not None), None)
 
     broken = [(link, shape, reason) for link in model.links for shape in link.visuals
               if (reason := undrawable_reason(shape)) is not None]

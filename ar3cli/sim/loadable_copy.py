@@ -76,14 +76,17 @@ class LeftOut(NamedTuple):
 
 
 def unloadable_mesh_reason(mesh: Any, resolver: Any) -> str | None:
-    """Why pybullet cannot load the ``<mesh>`` element ``mesh``: its file is not found, or a format pybullet
-    does not read (the whole robot is then refused); None when it can (or ``mesh`` is no mesh)."""
+    """Why pybullet cannot load the geometry element ``mesh`` (a ``<mesh>``, or PyBullet's ``<cdf>``): its
+    file is not found, or a mesh format pybullet does not read (the whole robot is then refused); None
+    when it can, or when the element names no file."""
     uri = (mesh.get("filename") or "").strip()
-    if mesh.tag != "mesh" or not uri:
+    if not uri:
         return None
     resolution = resolver.resolve(uri)
     if not resolution.found:
-        return f"mesh {uri}: {resolution.problem or 'file not found'}"
+        return f"{mesh.tag} {uri}: {resolution.problem or 'file not found'}"
+    if mesh.tag != "mesh":
+        return None
     suffix = Path(uri).suffix.lower()
     if suffix not in PYBULLET_MESH_FORMATS:
         return f"pybullet cannot load '{suffix or 'no extension'}' meshes ({uri})"
@@ -105,8 +108,9 @@ def _unloadable(root: Any, model: Model, roles: set[str]) -> list[tuple[Any, str
         for shape in link:
             if shape.tag not in roles:
                 continue
-            for mesh in shape.iter("mesh"):
-                reason = unloadable_mesh_reason(mesh, model.resolver)
+            for geometry in shape.iter("geometry"):
+                reasons = (unloadable_mesh_reason(element, model.resolver) for element in geometry)
+                reason = next((reason for reason in reasons if reason is not None), None)
                 if reason is not None:
                     found.append((shape, link.get("name") or "", shape.tag, reason))
                     break
