@@ -58,6 +58,7 @@ COMMANDS: dict[str, str] = {
     "render": "ar3cli.commands.render:render_command",
     "fk-verify": "ar3cli.commands.fk_verify:fk_verify",
     "lint-urdf": "ar3cli.commands.lint_urdf:lint_urdf",
+    "expand": "ar3cli.commands.expand:expand",
     "grasp-demo": "ar3cli.commands.grasp_demo:grasp_demo",
     **_fixer_commands(),
     "sample-collisions": "ar3cli.commands.sample_collisions:sample_collisions",
@@ -149,7 +150,7 @@ def _main(argv: list[str] | None) -> None:
         exc.show()
         sys.exit(EXIT_USAGE)
     except usage_error as exc:
-        command = exc.ctx.command_path if getattr(exc, "ctx", None) is not None else "ar3cli"
+        command = exc.ctx.command_path if getattr(exc, "ctx", None) is not None else _command_path(argv)
         message = " ".join(exc.format_message().replace("Value error, ", "").split())
         _say(f"ar3cli: error: {message} (see '{command} --help')")
         sys.exit(EXIT_USAGE)
@@ -166,6 +167,13 @@ def _main(argv: list[str] | None) -> None:
         _say(f"ar3cli: internal error: {type(exc).__name__}: {exc} (rerun with AR3CLI_DEBUG=1 for a traceback "
              "and report it)")
         sys.exit(EXIT_INTERNAL)
+
+
+def _command_path(argv: list[str] | None) -> str:
+    """``ar3cli COMMAND`` for the command ``argv`` names, ``ar3cli`` when none: click raises some usage
+    errors (an option missing its value, ``render --output``) before it makes the command's context."""
+    args = sys.argv[1:] if argv is None else argv
+    return f"ar3cli {args[0]}" if args and args[0] in COMMANDS else "ar3cli"
 
 
 def _say(line: str) -> None:

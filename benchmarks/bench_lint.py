@@ -22,7 +22,9 @@ Whole processes, alternating, warm-up first (see ``benchmarks/_timing.py``). Thr
    --no-cache panda.urdf`` (a fresh process; the mesh boxes are cached by the warm-up, the file is
    checked again) against one baseline call (``check_urdf panda.urdf`` itself when installed, and
    one run of the Python parser script), with ``python -c pass`` for scale.
-3. **example-robot-data, 40 robots** spread evenly over its sorted URDF list: ``ar3cli lint-urdf
+3. **the whole pybullet_data folder** (1,095 URDF files in pybullet 3.2.7, ``random_urdfs/``
+   included), ``ar3cli lint-urdf <folder>`` with an empty ar3cli cache and with its results cached.
+4. **example-robot-data, 40 robots** spread evenly over its sorted URDF list: ``ar3cli lint-urdf
    --no-cache <40 files>`` with an EMPTY ar3cli cache (``AR3CLI_CACHE_DIR`` a fresh folder per run:
    every mesh is read and parsed) against the same with the mesh cache warm, and a plain re-run
    (results cached: nothing changed since the last run). Needs example-robot-data in
@@ -193,6 +195,20 @@ def main() -> None:
         floor = _timing.Variant("`python -c pass` (interpreter start-up, for scale)", [sys.executable, "-c", "pass"])
         print(_timing.table(_timing.measure("one file: franka_panda/panda.urdf, a fresh process",
                                             [ours, *variants, floor], args.runs, notes=notes)))
+
+        every = sum(1 for _ in data.rglob("*.urdf"))
+        empties = itertools.count()
+
+        def empty_cache_folder() -> dict[str, str]:
+            return {"AR3CLI_CACHE_DIR": str(_timing.WORK / f"whole-{next(empties)}")}
+
+        whole = [*lint, str(data)]
+        print(_timing.table(_timing.measure(
+            f"the whole pybullet_data folder ({every:,} URDF files, random_urdfs/ included), one call", [
+                _timing.Variant("empty ar3cli cache (a fresh AR3CLI_CACHE_DIR each run)", whole,
+                                prepare=empty_cache_folder, ok_codes=(0, 1)),
+                _timing.Variant("cached (files unchanged since the warm-up)", whole, ok_codes=(0, 1)),
+            ], args.runs)))
 
         if args.skip_erd:
             pass

@@ -30,6 +30,13 @@ def test_usage_errors_are_one_line_with_exit_2(cli):
         assert line.startswith("ar3cli: error: ") and "--help" in line and "Value error" not in line
 
 
+def test_an_option_without_its_value_names_the_commands_own_help(cli):
+    """click raises this one before the command's context exists: it pointed at 'ar3cli --help'."""
+    result = cli("render", "robot.urdf", "--output")
+    assert result.code == 2
+    assert result.stderr.strip() == "ar3cli: error: Option '--output' requires an argument. (see 'ar3cli render --help')"
+
+
 def test_no_arguments_shows_help(cli):
     result = cli()
     assert result.code == 2 and "Usage:" in result.stdout and "lint-urdf" in result.stdout

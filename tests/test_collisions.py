@@ -230,12 +230,13 @@ def test_only_visual_geometry_is_a_clear_error(cli, write_urdf):
     assert "Traceback" not in result.stderr and result.stderr.count("\n") == 1
 
 
-def test_model_that_does_not_load_is_a_clear_error(cli, write_urdf):
+def test_a_missing_mesh_leaves_its_link_out_of_the_matrix(cli, write_urdf):
     text = TRANSPARENT.replace('<box size="0.3 0.04 0.04"/>', '<mesh filename="missing_arm.stl"/>')
     result = cli("sample-collisions", str(write_urdf(text)), "-n", "10", "--format", "json")
-    assert result.code == 2 and result.stdout == ""
-    assert "missing_arm.stl" in result.stderr and "Traceback" not in result.stderr
-    assert result.stderr.count("\n") == 1
+    assert result.code == 0 and "Traceback" not in result.stderr
+    data = json.loads(result.stdout)
+    assert data["unchecked_links"] and data["warnings"][0]["rule"] == "collision-left-out"
+    assert "missing_arm.stl" in data["warnings"][0]["message"]
 
 
 RIGID = """<robot name="rigid">

@@ -13,7 +13,8 @@ import pytest
 from ar3cli.cli import COMMANDS
 
 PLANS = sorted(path.stem for path in (Path(__file__).resolve().parents[1] / "ar3cli" / "fix").glob("*_plan.py"))
-SHARED = ["--diff", "--check", "--output", "--follow-symlinks", "--package-path", "--format"]
+SHARED = ["--diff", "--check", "--output", "--follow-symlinks", "--package-path", "--xacro-arg", "--xacro",
+          "--xacro-env", "--format"]
 
 
 @pytest.mark.parametrize("plan", PLANS)

@@ -189,6 +189,15 @@ def test_a_real_error_on_a_mobile_base_still_fails(cli, write_urdf) -> None:
     assert data["max_position_error_m"] > 1e-4 > data["largest_position_tolerance_m"]
 
 
+def test_a_robot_without_movable_joints_says_so_instead_of_an_empty_configuration(cli, write_urdf) -> None:
+    path = write_urdf('<robot name="r"><link name="a"/><link name="b"/>'
+                      '<joint name="f" type="fixed"><parent link="a"/><child link="b"/><origin xyz="0 0 1"/></joint></robot>')
+    result = cli("fk-verify", str(path), "--samples", "3")
+    assert result.code == 0, result.stderr
+    assert "(no movable joint: every sample is the same configuration)" in result.stdout
+    assert "(sample 0: )" not in result.stdout
+
+
 def test_link_reach_includes_the_ancestors() -> None:
     """An arm folded back to the origin from a base 20 m out is rounded like a point 20 m out."""
     frames = {name: np.tile(np.eye(4), (1, 1, 1)) for name in ("base", "arm")}

@@ -283,3 +283,30 @@ def test_png_refused_before_any_work(cli, tmp_path):
         (line,) = result.stderr.strip().splitlines()
         assert message in line and "missing.urdf" not in line  # refused before the robot is read
     assert "must end in .png" in cli("info", str(AR3), "--png", str(tmp_path / "t.jpg")).stderr
+
+
+def test_info_says_what_pybullet_weighs(cli, session):
+    """jackal's root frame and sensor frames have no <inertial>: PyBullet gives each 1 kg (a fixed base 0)."""
+    from ar3cli.urdf.model import load_model
+
+    path = Path(__file__).parent / "data" / "inertia" / "jackal_frames.urdf"
+    result = cli("info", str(path), "--format", "json")
+    data = json.loads(result.stdout)
+    assert data["total_mass_kg"] == pytest.approx(17.0)
+    for fixed, key in ((False, "floating"), (True, "fixed_base")):
+        body = session.load(load_model(path), fixed_base=fixed)
+        simulated = sum(body.dynamics(name).mass for name in body.link_names)
+        assert data["pybullet_mass_kg"][key] == pytest.approx(simulated)
+        body.remove()
+    assert data["pybullet_mass_kg"] == {"floating": pytest.approx(20.0), "fixed_base": pytest.approx(19.0)}
+    text = cli("info", str(path)).stdout
+    assert "PyBullet simulates 20 kg floating, 19 kg with a fixed base" in text
+
+
+def test_an_srdf_is_one_line_not_empty_tables(cli):
+    path = Path(__file__).parent / "data" / "srdf" / "ar3.srdf"
+    result = cli("info", str(path))
+    assert result.code == 2 and result.stdout == ""
+    assert result.stderr.strip() == (f"ar3cli: error: {path}: is an SRDF (MoveIt's semantic description: <group>, no "
+                                     "<link>), not a URDF; give the URDF it describes (sample-collisions "
+                                     "--srdf-compare reads an SRDF)")

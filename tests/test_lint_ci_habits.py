@@ -48,7 +48,7 @@ def test_explain_prints_the_rules_documentation(cli):
     assert rule.why.split()[0] in text and "Why it matters:" in text and "Fix:" in text
     assert f"Fixed by:\n  ar3cli {rule.fixed_by}" in text
     assert "Failing example:" in text and "Passing example:" in text and rule.bad.splitlines()[1].strip() in text
-    assert text.rstrip().endswith(f"#{rule.anchor}")
+    assert text.rstrip().endswith(f"Docs: docs/rules.md#{rule.anchor} in ar3cli's source")
     by_name = cli("lint-urdf", "--explain", rule.name)
     assert by_name.code == 0 and by_name.stdout == text
 
@@ -68,7 +68,7 @@ def test_explain_shows_fields_a_rule_may_gain(monkeypatch):
     from ar3cli.lint.engine import rule_document
     from ar3cli.output.explain import explain_text
 
-    document = {**rule_document(REGISTRY["J001"]), "url": "u", "measured_on": "Talos, TIAGo"}
+    document = {**rule_document(REGISTRY["J001"]), "doc": "u", "measured_on": "Talos, TIAGo"}
     assert "Measured on:\n  Talos, TIAGo" in explain_text(document)
 
 

@@ -57,7 +57,10 @@ def test_sarif_validates_against_the_schema(cli, write_urdf, tmp_path):
     assert results["F002"]["level"] == "error"
     rule_ids = [r["id"] for r in run["tool"]["driver"]["rules"]]
     assert rule_ids[results["J001"]["ruleIndex"]] == "J001"
-    assert run["tool"]["driver"]["rules"][0]["helpUri"].endswith("docs/rules.md#f001-unreadable")
+    first = run["tool"]["driver"]["rules"][0]
+    assert "helpUri" not in first and "informationUri" not in run["tool"]["driver"]  # no made-up address
+    assert first["help"]["markdown"].endswith("`ar3cli lint-urdf --explain F001`, or "
+                                              "docs/rules.md#f001-unreadable in ar3cli's source.")
 
 
 def test_github_annotations_escape_properties_and_data(cli, write_urdf):

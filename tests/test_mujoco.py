@@ -32,6 +32,16 @@ def test_cross_check_names_the_mimic_joint_and_the_engine_that_enforces_it():
     assert "PyBullet ignores it" in diagnosis and "line 38" in diagnosis
 
 
+def test_cross_check_holds_the_joints_nothing_couples():
+    """The reaction of a mimic constraint turns a light arm in MuJoCo (ERD's panda: panda_joint6 when
+    panda_finger_joint1 moves): the probe holds every joint without <mimic>, so no undiagnosed row is left."""
+    result = run("cross-check", str(DATA / "gripper_arm_light.urdf"), "-n", "1", "--format", "json")
+    data = json.loads(result.stdout)
+    constraint = [row for row in data["rows"] if row["quantity"].startswith("constraint")]
+    assert [row["where"] for row in constraint] == ["'finger_right_joint' when 'finger_left_joint' moves +0.005"]
+    assert all(row["diagnosis"] for row in data["rows"]), data["rows"]
+
+
 def test_cross_check_agrees_without_the_mimic():
     result = run("cross-check", str(FREE), "-n", "2", "--seed", "3")
     assert result.returncode == 0, result.stdout + result.stderr
@@ -129,9 +139,26 @@ def _cube_stl(size: float, binary: bool = True) -> bytes:
     return ("\n".join([*lines, "endsolid cube"]) + "\n").encode()
 
 
-def test_engine_without_sim_is_a_usage_error():
-    result = run("lint-urdf", "--engine", "mujoco", str(FREE))
-    assert result.returncode == 2 and "add --sim" in result.stderr
+def test_engine_mujoco_implies_sim(tmp_path):
+    from ar3cli.lint.rules import REGISTRY
+
+    path = tmp_path / "stacked.urdf"
+    path.write_text(REGISTRY["M003"].bad)
+    result = run("lint-urdf", "--engine", "mujoco", "--select", "M003", str(path), "--format", "json")
+    assert [finding["rule"] for finding in json.loads(result.stdout)["findings"]] == ["M003"], result.stderr
+
+
+def test_engine_all_reports_a_pair_both_engines_find_once_in_one_unit(tmp_path):
+    """P002 and M003 on one pair were two findings, in '150.0 mm' and '150 mm': now P002's names MuJoCo's too."""
+    from ar3cli.lint.rules import REGISTRY
+
+    path = tmp_path / "stacked.urdf"
+    path.write_text(REGISTRY["M003"].bad)
+    result = run("lint-urdf", "--engine", "all", "--select", "P002,M003", str(path), "--format", "json")
+    (finding,) = json.loads(result.stdout)["findings"]
+    assert finding["rule"] == "P002"
+    assert finding["message"] == ("links 'base' and 'tip' interpenetrate by 150.0 mm at the home pose; "
+                                  "in MuJoCo too (150.0 mm, M003)")
 
 
 def test_mujoco_compile_error_names_the_link_and_its_line(tmp_path):

@@ -86,12 +86,14 @@ def test_mass_zero_with_inertia(tmp_path):
 def test_world_inertial_and_root_without_inertial(tmp_path):
     world = write_fixture(tmp_path, REGISTRY["I011"].bad)
     assert codes_for(world, "I011") and codes_for(world, "I012") == []
-    for root in ("base_footprint", "world"):  # frames by convention, with or without geometry
-        text = robot(f'<link name="{root}"><visual><geometry><box size="1 1 1"/></geometry></visual></link>')
-        assert codes_for(write_fixture(tmp_path, text), "I012") == []
-    frame_root = robot(f"""<link name="base"/><link name="chassis">{LINK_INERTIAL}</link>
-        <joint name="j" type="fixed"><parent link="base"/><child link="chassis"/></joint>""")
-    assert codes_for(write_fixture(tmp_path, frame_root), "I012") == []
+    text = robot('<link name="world"><visual><geometry><box size="1 1 1"/></geometry></visual></link>')
+    assert codes_for(write_fixture(tmp_path, text), "I012") == []  # PyBullet gives a link named world 0 kg
+    # jackal's root: a frame without geometry or <inertial>, which PyBullet still weighs 1 kg when it floats
+    frame_root = robot(f"""<link name="base_link"/><link name="chassis">{LINK_INERTIAL}</link>
+        <joint name="j" type="fixed"><parent link="base_link"/><child link="chassis"/></joint>""")
+    (frame,) = codes_for(write_fixture(tmp_path, frame_root), "I012")
+    assert "is a frame (no geometry)" in frame.message and "1 kg" in frame.message and "tiny <inertial>" in frame.hint
+    assert codes_for(write_fixture(tmp_path, arm()), "I012") == []  # an arm turning on its mounting frame
     (finding,) = codes_for(write_fixture(tmp_path, REGISTRY["I012"].bad), "I012")
     assert "if this robot floats" in finding.message and "fix-inertia --links chassis" in finding.hint
 

@@ -4,6 +4,7 @@ to the local backend's (real Ray, local, 2 CPUs). Assets are generated in tmp_pa
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import signal
@@ -107,6 +108,9 @@ def test_an_interrupted_scan_resumes_with_no_file_lost_or_doubled(tmp_path: Path
     assert process.returncode == (130 if how is signal.SIGINT else -signal.SIGKILL), err
     partial = len(stored(store))
     assert 0 < partial < 40
+    if how is signal.SIGINT:  # it says what is stored and how to go on
+        assert f"files checked in this run; {partial} files are stored in {store}" in err, err
+        assert "Run the same command again to go on" in err
 
     rerun = ar3cli("scan", str(tmp_path / "robots"), "--store", str(store), "-f", "json")
     assert rerun.returncode == 0, rerun.stderr
@@ -171,13 +175,82 @@ def test_ray_backend_without_ray_is_one_line_exit_2(monkeypatch) -> None:
     assert raised.value.exit_code == 2
 
 
-def test_ray_backend_gives_the_same_rows_as_the_local_backend(tmp_path: Path) -> None:
-    pytest.importorskip("ray")
+@pytest.fixture
+def ray_head(tmp_path: Path):
+    """A real Ray head on 127.0.0.1 (``ray start --head --block``) with token authentication on, as Ray
+    2.60 starts it wherever ``~/.ray/auth_token`` exists (any earlier local ``ray.init()`` writes one), in
+    its own session and temporary folders and a HOME of its own: yields (its address, the environment
+    to join it with); its whole process group is stopped afterwards."""
+    import shutil
+    import socket
+    import tempfile
+
+    if shutil.which("ray") is None and not (Path(sys.executable).parent / "ray").exists():
+        pytest.skip("Ray is not installed (pip install 'ar3cli[ray]')")
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    home = tmp_path / "home"
+    home.mkdir()
+    temp = Path(tempfile.mkdtemp(prefix="ray", dir="/tmp"))  # Ray's socket paths must stay short
+    env = {**os.environ, "HOME": str(home), "RAY_USAGE_STATS_ENABLED": "0"}
+    env.pop("RAY_AUTH_MODE", None)
+    ray = str(Path(sys.executable).parent / "ray")
+    subprocess.run([ray, "get-auth-token", "--generate"], env=env, capture_output=True, check=True, timeout=60)
+    command = [ray, "start", "--head", "--block", "--node-ip-address", "127.0.0.1",
+               "--port", str(port), "--num-cpus", "1", "--include-dashboard", "false", "--temp-dir", str(temp),
+               "--disable-usage-stats"]
+    head = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+                            start_new_session=True)
+    try:
+        said = []
+        for line in head.stdout:  # type: ignore[union-attr]
+            said.append(line)
+            if "Ray runtime started" in line:
+                break
+        else:
+            pytest.fail("ray start --head ended: " + "".join(said[-5:]))
+        assert (home / ".ray" / "auth_token").is_file(), "".join(said)  # token authentication, Ray's default
+        yield f"127.0.0.1:{port}", env
+    finally:  # the head's own group, and only it: SIGTERM keeps `ray start --block` busy for 30 s and more
+        with contextlib.suppress(ProcessLookupError):
+            os.killpg(head.pid, signal.SIGKILL)
+        head.wait()
+        shutil.rmtree(temp, ignore_errors=True)
+
+
+def test_ray_joins_a_running_head_and_gives_the_local_backends_rows(tmp_path: Path, ray_head) -> None:
+    """issue 36 item 9: a driver given --address joined no token-authenticated cluster; and a scan that
+    starts its own Ray must not join the one running here (it failed: "num_cpus ... must not be provided")."""
+    address, env = ray_head
     make_assets(tmp_path / "robots", 8)
-    local, ray = tmp_path / "local.sqlite", tmp_path / "ray.sqlite"
+    local, joined, own = tmp_path / "local.sqlite", tmp_path / "joined.sqlite", tmp_path / "own.sqlite"
     assert ar3cli("scan", str(tmp_path / "robots"), "--store", str(local)).returncode == 0
-    result = ar3cli("scan", str(tmp_path / "robots"), "--store", str(ray), "--backend", "ray", "--jobs", "2",
-                    "-f", "json")
+
+    def scan(store: Path, *extra: str) -> subprocess.CompletedProcess:
+        return subprocess.run([sys.executable, "-m", "ar3cli", "scan", str(tmp_path / "robots"), "--store", str(store),
+                               "--backend", "ray", "-f", "json", *extra], capture_output=True, text=True, timeout=300,
+                              env={**env, "PYTHONPATH": str(REPO)})
+
+    result = scan(joined, "--address", address)
     assert result.returncode == 0, result.stderr
-    assert json.loads(result.stdout)["backend"] == "ray"
-    assert stored(ray) == stored(local) and len(stored(ray)) == 8
+    assert json.loads(result.stdout)["backend"] == "ray" and result.stderr == ""  # Ray's own logging kept quiet
+    assert stored(joined) == stored(local) and len(stored(joined)) == 8
+    started = scan(own, "--jobs", "1")
+    assert started.returncode == 0, started.stderr
+    assert stored(own) == stored(local)
+
+
+def test_a_wrong_ray_address_is_one_line_at_once(tmp_path: Path) -> None:
+    import socket
+
+    pytest.importorskip("ray")
+    make_assets(tmp_path / "robots", 1)
+    with socket.socket() as probe:  # a port nobody listens on
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    result = ar3cli("scan", str(tmp_path / "robots"), "--store", str(tmp_path / "s.sqlite"), "--backend", "ray",
+                    "--address", f"127.0.0.1:{port}", timeout=60)
+    assert result.returncode == 2
+    assert result.stderr.startswith(f"ar3cli: error: cannot reach Ray at 127.0.0.1:{port}: ")
+    assert result.stderr.count("\n") == 1

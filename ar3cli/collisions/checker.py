@@ -46,7 +46,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 import numpy as np
 
-from ar3cli.sim.adjacency import collision_links, direct_parent_child, rigid_groups
+from ar3cli.sim.adjacency import collision_links, direct_parent_child, rigid_groups, unloadable_collision_links
 from ar3cli.sim.sampling import JointSpace, joint_space
 from ar3cli.sim.session import PENETRATION_TOLERANCE, SELF_COLLISION_DEFAULT
 from ar3cli.urdf.model import Model
@@ -61,7 +61,7 @@ class Checker:
     """One PyBullet client with the model loaded for self-collision; counts colliding pairs.
 
     ``pairs`` are the unordered pairs of :attr:`links` (links with collision geometry, in pybullet
-    order, base first), as (i, j) with i < j; counts are indexed like ``pairs``. The pairs in
+    order, base first; not the :attr:`unchecked` ones), as (i, j) with i < j; counts are indexed like ``pairs``. The pairs in
     :attr:`unsampled` (a link and its direct parent) are never checked: their count stays 0. The
     pairs in :attr:`constant` (joined only through joints no configuration moves) are checked once,
     at load: their count is every configuration or none.
@@ -75,11 +75,13 @@ class Checker:
             p, client = self.session.p, self.session.client
             p.setPhysicsEngineParameter(contactBreakingThreshold=CONTACT_BREAKING_THRESHOLD,
                                         physicsClientId=client)
-            self.body = self.session.load(model, self_collision=SELF_COLLISION_DEFAULT, visuals=False)
+            self.body = self.session.load(model, self_collision=SELF_COLLISION_DEFAULT, visuals=False,
+                                          leave_out_unloadable=True)
         except BaseException:
             self.session.close()
             raise
-        with_geometry = set(collision_links(model))
+        self.unchecked: list[str] = unloadable_collision_links(model)
+        with_geometry = set(collision_links(model)) - set(self.unchecked)
         self.links: list[str] = [name for name in self.body.link_names if name in with_geometry]
         self.pairs: list[tuple[int, int]] = [(i, j) for i in range(len(self.links))
                                              for j in range(i + 1, len(self.links))]

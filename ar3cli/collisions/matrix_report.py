@@ -22,7 +22,7 @@ def matrix_report(model: Model, run: MatrixRun, fmt: OutputFormat | str,
     data = {
         "path": str(model.path), "robot": model.name, "samples": run.samples, "seed": run.seed, "jobs": run.jobs,
         "always_threshold": run.always_threshold, "contact_tolerance_m": PENETRATION_TOLERANCE,
-        "links": list(run.links), "limit_configurations": run.limit_configurations,
+        "links": list(run.links), "unchecked_links": list(run.unchecked), "limit_configurations": run.limit_configurations,
         "pairs": [result.to_dict() for result in run.results],
         "categories": counts, "never_upper_bound": never_bound,
         "warnings": [finding.to_dict() for finding in run.warnings],

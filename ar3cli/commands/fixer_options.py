@@ -4,8 +4,10 @@ A fixer is one module, ``fix/NAME_plan.py``, exporting ``FIXER`` (a :class:`~ar3
 there is no command module per fixer. The command's signature is the file argument first, the
 fixer's own options (declared on its options dataclass with :func:`~ar3cli.fix.settings.setting`),
 then the options every fixer takes, declared here once: ``--diff``, ``--check``, ``-o``,
-``--follow-symlinks``, ``--package-path``, ``--format`` and (for the fixers that start a child
-process) ``--timeout``. The shared values reach the fixer as one :class:`~ar3cli.fix.driver.FixerArgs`.
+``--follow-symlinks``, ``--package-path``, the xacro options (``--xacro-arg``, ``--xacro``,
+``--xacro-env``: a fixer that edits xacro sources reads them as every command does), ``--format``
+and (for the fixers that start a child process) ``--timeout``. The shared values reach the fixer
+as one :class:`~ar3cli.fix.driver.FixerArgs`.
 """
 
 from __future__ import annotations
@@ -26,6 +28,10 @@ from ar3cli.commands.options import (
     PackagePathOption,
     SeedOption,
     TimeoutOption,
+    XacroArgOption,
+    XacroEnvOption,
+    XacroMode,
+    XacroModeOption,
     finite_float,
     keyword_parameter,
 )
@@ -36,6 +42,10 @@ if TYPE_CHECKING:
 
 FixPathsArgument = Annotated[list[Path], typer.Argument(metavar="PATH", show_default=False,
                                                         help=".urdf files to fix (xacro is refused).")]
+XacroFixPathsArgument = Annotated[list[Path], typer.Argument(
+    metavar="PATH", show_default=False,
+    help=".urdf or .xacro files to fix (a xacro source where the value is literal text in it; each element "
+         "that is not is listed with the reason).")]
 DiffOption = Annotated[bool, typer.Option("--diff", help="Print a unified diff and write nothing.")]
 CheckOption = Annotated[bool, typer.Option("--check", help="Write nothing; exit 1 when a change is needed.")]
 OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_default=False,
@@ -44,9 +54,13 @@ OutputOption = Annotated[Optional[Path], typer.Option("--output", "-o", show_def
 
 
 PATHS = keyword_parameter("paths", FixPathsArgument)
+XACRO_PATHS = keyword_parameter("paths", XacroFixPathsArgument)
 SHARED = (keyword_parameter("diff", DiffOption, False), keyword_parameter("check", CheckOption, False),
           keyword_parameter("output", OutputOption, None), keyword_parameter("follow_symlinks", FollowSymlinksOption, False),
           keyword_parameter("package_path", PackagePathOption, None),
+          keyword_parameter("xacro_arg", XacroArgOption, None),
+          keyword_parameter("xacro", XacroModeOption, XacroMode.safe),
+          keyword_parameter("xacro_env", XacroEnvOption, None),
           keyword_parameter("format", FormatOption, "text"))
 """After the command's own options, in this order (``--help`` lists them so)."""
 
@@ -65,12 +79,13 @@ def fixer_command(fixer: Fixer) -> Callable[..., None]:
 
     own = [_own_option(item) for item in settings_of(fixer.options)] if fixer.options is not None else []
     tail = [] if fixer.timeout is None else [keyword_parameter("timeout", TimeoutOption, fixer.timeout)]
-    parameters = [PATHS, *own, *SHARED, *tail]
+    parameters = [XACRO_PATHS if fixer.edits_xacro else PATHS, *own, *SHARED, *tail]
 
     def command(**values: Any) -> None:
         from ar3cli.fix.driver import FixerArgs
 
         shared = {parameter.name: values.pop(parameter.name) for parameter in (PATHS, *SHARED)}
+        shared["xacro_trusted"] = XacroMode(shared.pop("xacro")) is XacroMode.trusted
         values.pop("timeout", None)  # set for the child processes by the option's callback
         options = fixer.options(**values) if fixer.options is not None else None
         raise typer.Exit(fixer.run(options, FixerArgs(**shared)))

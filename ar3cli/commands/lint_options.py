@@ -28,6 +28,9 @@ class FailOn(str, enum.Enum):
     info = "info"
 
 
+SIM_PANEL = "Simulation"
+"""lint-urdf's ``--help`` panels: its options grouped, so that each panel's columns fit 80 characters."""
+CI_PANEL = "Baselines, changes and output"
 KINDS = (LINT,)
 """lint-urdf's report: lint findings (every format that renders them)."""
 LintFormatOption = format_option(KINDS, "LintFormat")
@@ -45,11 +48,11 @@ FailOnOption = Annotated[Optional[FailOn], typer.Option(
 ExitZeroOption = Annotated[bool, typer.Option("--exit-zero", help="Exit 0 even when there are findings.")]
 SimOption = Annotated[bool, typer.Option(
     "--sim", help="Also load each model in PyBullet (P rules): load errors, self-collision at home, inertia "
-                  "PyBullet really uses, stability.")]
+                  "PyBullet really uses, stability.", rich_help_panel=SIM_PANEL)]
 EngineOption = Annotated[Engine, typer.Option(
-    "--engine", help="With --sim: the simulator(s) to check in: PyBullet (P rules), MuJoCo (M rules: compile, "
+    "--engine", help="The simulator(s) --sim checks in: PyBullet (P rules), MuJoCo (M rules: compile, "
                      "unreadable meshes, contacts at home, 1 s under gravity; needs pip install 'ar3cli[mujoco]'), "
-                     "or all.")]
+                     "or all; mujoco and all imply --sim.", rich_help_panel=SIM_PANEL)]
 NoConfigOption = Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
 JobsOption = Annotated[Optional[int], typer.Option(
     "--jobs", "-j", min=1, show_default=False,
@@ -61,31 +64,31 @@ NoCacheOption = Annotated[bool, typer.Option(
                        "runs (also AR3CLI_NO_CACHE=1).")]
 FixHintOption = Annotated[bool, typer.Option(
     "--fix-hint", help="After the findings, print the ar3cli command lines that fix them, one per fixer and file "
-                       "(JSON: fix_commands).")]
+                       "(JSON: fix_commands).", rich_help_panel=CI_PANEL)]
 GroupOption = Annotated[Optional[bool], typer.Option(
     "--group/--no-group", help="Text format: show 5 or more alike findings of one rule in one file as one row "
                                "(count, first locations, message); github, markdown, sarif and junit: one "
                                "annotation, row, result or test case per rule and file. On by default; JSON keeps "
-                               "every finding.", show_default=False)]
+                               "every finding.", show_default=False, rich_help_panel=CI_PANEL)]
 WideOption = Annotated[bool, typer.Option(
     "--wide", help="Text format: the table, one line per finding however wide (for wide log viewers). By "
                    "default tables fit the terminal (or COLUMNS) and wrap messages; piped without COLUMNS "
                    "(pre-commit, CI logs), each finding is one line: path:line:col: CODE [severity] message.")]
 BaselineOption = Annotated[Optional[Path], typer.Option(
     "--baseline", metavar="FILE", help="Do not report (or fail on) the findings this baseline file holds; only new "
-                                       "ones count.", show_default=False)]
+                                       "ones count.", show_default=False, rich_help_panel=CI_PANEL)]
 WriteBaselineOption = Annotated[Optional[Path], typer.Option(
     "--write-baseline", metavar="FILE", help="Write every finding of this run to FILE as the baseline (for "
-                                             "--baseline) and exit 0.", show_default=False)]
+                                             "--baseline) and exit 0.", show_default=False, rich_help_panel=CI_PANEL)]
 ChangedSinceOption = Annotated[Optional[str], typer.Option(
     "--changed-since", metavar="REF", help="Only the robot files under PATH changed since this git ref (and "
                                            "untracked ones), and those using a changed mesh or included xacro file.",
-    show_default=False)]
+    show_default=False, rich_help_panel=CI_PANEL)]
 ExplainOption = Annotated[Optional[str], typer.Option(
     "--explain", metavar="CODE", help="Print a rule's documentation (why, fix, examples) and exit; takes no PATH.",
     show_default=False)]
 SrdfOption = Annotated[Optional[Path], typer.Option(
-    "--srdf", metavar="FILE.srdf", dir_okay=False,
+    "--srdf", metavar="FILE.srdf", dir_okay=False, rich_help_panel=SIM_PANEL,
     help="With --sim: link pairs this MoveIt SRDF disables are not reported as colliding at home (P002).")]
 TargetOption = Annotated[Optional[list[str]], typer.Option(
     "--target", metavar="ENGINES",

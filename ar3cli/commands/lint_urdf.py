@@ -99,8 +99,11 @@ def lint_urdf(
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_args import parse_xacro_args
 
-    if Engine(engine) is not Engine.pybullet and not sim:
-        raise UserError("--engine chooses the simulator of --sim: add --sim")
+    sim = sim or Engine(engine) is not Engine.pybullet  # --engine mujoco|all asks for a simulation
+    from ar3cli.infra.isolation import announce_slow_work
+    from ar3cli.output.report import log
+
+    announce_slow_work(lambda line: log(f"lint-urdf: {line}"))  # a humanoid's --sim takes ~7 s: say so on stderr
     engines = ("pybullet", "mujoco") if engine is Engine.all else (Engine(engine).value,)
     if sim and "mujoco" in engines:
         from ar3cli.sim.mujoco_session import import_mujoco
@@ -171,12 +174,12 @@ def _write_baseline(path: Path, results, fmt, follow_symlinks: bool = False) -> 
 
 def explain_rule(code: str, fmt) -> None:
     """``--explain CODE``: the rule's documentation in the terminal (or as JSON), exit 0."""
+    from ar3cli import RULES_DOC
     from ar3cli.lint.engine import find_rule, rule_document
     from ar3cli.output.explain import explain_text
-    from ar3cli.output.sarif import RULES_URL
 
     document = rule_document(find_rule(code))
-    document["url"] = f"{RULES_URL}#{document['anchor']}"
+    document["doc"] = f"{RULES_DOC}#{document['anchor']}"
     if fmt == "json":
         finish(Report(data=document), "json")
     finish(Report(data=document, text=explain_text(document)), "text")

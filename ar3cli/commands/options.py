@@ -27,15 +27,19 @@ def format_option(kinds: tuple[str, ...], enum_name: str) -> Any:
 
 
 FormatOption = format_option((REPORT,), "ReportFormat")
+SHARED_PANEL = "Robot files, writes and limits (the same in every command)"
+"""The ``--help`` panel of the options many commands share: in their own box, with their own column
+widths, they no longer squeeze each command's options into a narrow help column."""
 PackagePathOption = Annotated[
     Optional[list[str]],
-    typer.Option("--package-path", metavar="NAME=DIR",
+    typer.Option("--package-path", metavar="NAME=DIR", rich_help_panel=SHARED_PANEL,
                  help="Where package://NAME/... lives (repeatable). Also searched: ROS_PACKAGE_PATH, "
                       "AMENT_PREFIX_PATH and the robot file's ancestor folders."),
 ]
 XacroArgOption = Annotated[
     Optional[list[str]],
-    typer.Option("--xacro-arg", metavar="NAME:=VALUE", help="A xacro argument for .xacro inputs (repeatable)."),
+    typer.Option("--xacro-arg", metavar="NAME:=VALUE", rich_help_panel=SHARED_PANEL,
+                 help="A xacro argument for .xacro inputs (repeatable)."),
 ]
 
 
@@ -48,14 +52,15 @@ class XacroMode(str, Enum):
 
 XacroModeOption = Annotated[
     XacroMode,
-    typer.Option("--xacro", help="How .xacro inputs are expanded. safe: expressions without Python eval, files only "
-                                 "from the robot's folder and packages, no environment variables, time and memory "
-                                 "limits. trusted: xacro as it is, which runs any Python the file holds; only for "
-                                 "your own files on your own machine."),
+    typer.Option("--xacro", rich_help_panel=SHARED_PANEL,
+                 help="How .xacro inputs are expanded. safe: expressions without Python eval, files only "
+                      "from the robot's folder and packages, no environment variables, time and memory "
+                      "limits. trusted: xacro as it is, which runs any Python the file holds; only for "
+                      "your own files on your own machine."),
 ]
 XacroEnvOption = Annotated[
     Optional[list[str]],
-    typer.Option("--xacro-env", metavar="NAME",
+    typer.Option("--xacro-env", metavar="NAME", rich_help_panel=SHARED_PANEL,
                  help="An environment variable .xacro inputs may read with $(env NAME) / $(optenv NAME) in safe "
                       "mode (repeatable; without it they are refused)."),
 ]
@@ -113,9 +118,10 @@ def samples_option(help: str, most: int) -> typer.models.OptionInfo:
 
 
 FollowSymlinksOption = Annotated[bool, typer.Option(
-    "--follow-symlinks", help="Write through an output path (or an in-place fix's file) that is a symbolic link, "
-                              "replacing the link's target. Without it such a path is refused: a link planted "
-                              "in a repository must not redirect a write.")]
+    "--follow-symlinks", rich_help_panel=SHARED_PANEL,
+    help="Write through an output path (or an in-place fix's file) that is a symbolic link, "
+         "replacing the link's target. Without it such a path is refused: a link planted "
+         "in a repository must not redirect a write.")]
 
 
 def _apply_timeout(seconds: float) -> float:
@@ -128,6 +134,7 @@ def _apply_timeout(seconds: float) -> float:
 
 TimeoutOption = Annotated[float, typer.Option(
     "--timeout", metavar="SECONDS", click_type=finite_float(min=0), callback=_apply_timeout,
+    rich_help_panel=SHARED_PANEL,
     help="Wall-clock limit per file for the process that runs pybullet (or a decomposition) on it: one that "
          "takes longer is stopped, and the file gets a one-line error. 0: no limit. Each such process may also "
          "map at most half of the memory (1-4 GB; AR3CLI_CHILD_MEMORY_MB sets it).")]

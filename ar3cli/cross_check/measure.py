@@ -1,6 +1,12 @@
 """What each engine says about one robot: frames, mass, centre of mass, mass matrix, gravity torques,
 and where the joints go when one leader joint is driven (the constraints the engine enforces).
 
+The constraint probe drives one leader joint and holds every joint that follows nothing (no
+``<mimic>``) at home, in both engines: only the kinematic coupling is compared. Left free, MuJoCo's
+arm joints move through the reaction forces of a driven finger (example-robot-data's panda:
+``panda_joint6`` by 0.0038 rad when ``panda_finger_joint1`` moves 0.01 m), a dynamic effect that no
+file error explains and that PyBullet, whose velocity motors hold its joints, does not show.
+
 Each engine runs in its own forked child (:func:`~ar3cli.sim.session.run_pybullet`,
 :func:`~ar3cli.sim.mujoco_session.run_mujoco`) and hands back plain arrays (:class:`EngineData`), so
 the comparison (:mod:`ar3cli.cross_check.compare`) never touches either engine. The configurations
@@ -54,6 +60,12 @@ class Plan:
     home: dict[str, float]
     steps: dict[str, float]
     """Leader (driving) joint -> signed step the probe moves it by."""
+    followers: list[str] = field(default_factory=list)
+    """Joints with a ``<mimic>``: the only ones the probe leaves free (the others are held at home)."""
+
+    def held(self, leader: str) -> list[str]:
+        """The joints the probe holds at home while it drives ``leader``: all but it and the followers."""
+        return [name for name in self.joints if name != leader and name not in self.followers]
 
 
 def plan_and_measure_pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
@@ -70,7 +82,7 @@ def measure_mujoco(model: Model, plan: Plan) -> EngineData:
     return run_mujoco(lambda: _mujoco(model, plan), model)
 
 
-def _plan(body: Any, samples: int, seed: int) -> Plan:
+def _plan(model: Model, body: Any, samples: int, seed: int) -> Plan:
     from ar3cli.sim.sampling import joint_space, sample_configurations
 
     space = joint_space(body)
@@ -82,7 +94,8 @@ def _plan(body: Any, samples: int, seed: int) -> Plan:
         lower, upper = float(space.lower[index]), float(space.upper[index])
         step = min(DRIVE_STEP, (upper - lower) / 4) if upper > lower else 0.0
         steps[name] = step if home[name] + step <= upper else -step
-    return Plan(list(space.names), [(label, space.as_dict(row)) for label, row in rows], home, steps)
+    followers = [name for name in space.names if (joint := model.joint(name)) is not None and joint.mimic is not None]
+    return Plan(list(space.names), [(label, space.as_dict(row)) for label, row in rows], home, steps, followers)
 
 
 def _pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
@@ -91,7 +104,7 @@ def _pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
 
     with Session(gravity=GRAVITY) as session:
         body = session.load(model, visuals=False)
-        plan = _plan(body, samples, seed)
+        plan = _plan(model, body, samples, seed)
         p, client = session.p, session.client
         data = EngineData("pybullet", plan.joints)
         # The base is welded to the world (useFixedBase): PyBullet reports its mass as 0 and MuJoCo fuses it
@@ -126,8 +139,11 @@ def _pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
         steps = round(DRIVE_SECONDS * 240)
         for leader, step in plan.steps.items():
             body.set_positions(plan.home)
+            held = [(by_name[name], plan.home[name]) for name in plan.held(leader)]
             for _ in range(steps):
                 p.resetJointState(body.id, by_name[leader], plan.home[leader] + step, 0.0, physicsClientId=client)
+                for index, value in held:
+                    p.resetJointState(body.id, index, value, 0.0, physicsClientId=client)
                 session.step()
             data.driven[leader] = {name: value - plan.home[name] for name, value in zip(plan.joints, body.positions())}
     return plan, data
@@ -178,10 +194,13 @@ def _mujoco(model: Model, plan: Plan) -> EngineData:
             continue
         robot.mujoco.mj_resetData(robot.m, robot.d)
         robot.set_positions(plan.home)
-        address, dof = robot.m.jnt_qposadr[robot.joint_ids[leader]], robot.m.jnt_dofadr[robot.joint_ids[leader]]
+        targets = [(robot.m.jnt_qposadr[robot.joint_ids[name]], robot.m.jnt_dofadr[robot.joint_ids[name]],
+                    plan.home[name] + (step if name == leader else 0.0))
+                   for name in [leader, *plan.held(leader)] if name in robot.joint_ids]
         for _ in range(steps):
-            robot.d.qpos[address] = plan.home[leader] + step
-            robot.d.qvel[dof] = 0.0
+            for address, dof, value in targets:
+                robot.d.qpos[address] = value
+                robot.d.qvel[dof] = 0.0
             robot.step()
         data.driven[leader] = {name: value - plan.home[name] for name, value in zip(known, robot.positions(known))}
     return data

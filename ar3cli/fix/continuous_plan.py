@@ -71,6 +71,10 @@ def plan_continuous(model, document: Document, options: ContinuousOptions) -> Fi
     return plan
 
 
+LIMIT_KEYS = ("lower", "upper", "effort", "velocity")
+"""The attributes of a ``<limit>`` this fixer reads and writes."""
+
+
 def _element(joint) -> str:
     return f"joint {joint.name}"
 
@@ -100,6 +104,10 @@ def _remove_fake_limits(document: Document, plan: FixPlan, joint, options: Conti
         have = next(key for key in final if final[key] is not None)
         plan.skipped.append(Skipped(_element(joint), line, f"its <limit> would keep {have} but no {missing[0]}; "
                                                            f"urdfdom requires both: pass --{missing[0]}"))
+        return
+    refused = document.refusal(limit if limit is not None else joint.element, LIMIT_KEYS)
+    if refused is not None:
+        plan.skipped.append(Skipped(_element(joint), line, refused))
         return
     reason = "ignored by the URDF spec; pybullet only clamps position targets to it"
     if missing:  # neither effort nor velocity: an empty <limit/> is invalid, a continuous joint needs none
@@ -153,6 +161,11 @@ def _to_revolute(document: Document, plan: FixPlan, joint, entry: YamlLimits, op
                                         f"becomes {new_type} but has no {key} in the file or {source}: "
                                         f"pass --{key}"))
             return
+    refused = document.refusal(joint.element, ("type",)) or (document.refusal(limit, LIMIT_KEYS)
+                                                             if limit is not None else None)
+    if refused is not None:
+        plan.skipped.append(Skipped(_element(joint), joint.line, refused))
+        return
     if joint.type != new_type:
         document.set_attribute(document.span(joint.element), "type", new_type)
         plan.changes.append(Change(_element(joint), joint.line, "type", joint.type, new_type,
@@ -182,6 +195,10 @@ def _full_turn_to_continuous(document: Document, plan: FixPlan, joint) -> None:
     if limit is None or limit.lower is None or limit.upper is None:
         return
     if limit.upper - limit.lower < FULL_TURN - FULL_TURN_TOLERANCE:
+        return
+    refused = document.refusal(joint.element, ("type",)) or document.refusal(limit.element, ("lower", "upper"))
+    if refused is not None:
+        plan.skipped.append(Skipped(_element(joint), joint.line, refused))
         return
     document.set_attribute(document.span(joint.element), "type", "continuous")
     reason = f"range {limit.upper - limit.lower:.4g} rad covers a full turn (--to-continuous)"
@@ -249,7 +266,7 @@ def _drive(session, body, index: int, target: float, steps: int = 2400) -> float
 
 
 FIXER = Fixer[ContinuousOptions]("fix-continuous", plan_continuous, verify, options=ContinuousOptions,
-                                  timeout=DEFAULT_TIMEOUT_S, help="""\
+                                  timeout=DEFAULT_TIMEOUT_S, edits_xacro=True, help="""\
 Fix continuous joints: lower/upper on a continuous joint only add a PyBullet position clamp.
 
 Default: remove them (keep effort/velocity). --limits-from turns joints with hard stops

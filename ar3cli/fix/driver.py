@@ -6,7 +6,8 @@ FixPlan`` that queues byte splices on the :class:`~ar3cli.urdf.edits.Document` a
 from) and a :class:`Skipped` for each element it could not fix, and optionally a verify function
 that checks the written file in PyBullet. Each ``fix/*_plan.py`` exports one as ``FIXER``.
 :func:`run_fixer` does everything else the same way for all fixers, as the :class:`FixerArgs`
-every fixer command takes ask: refuses xacro, builds the new bytes, checks they still parse,
+every fixer command takes ask: edits a xacro source where the fixer can (:attr:`Fixer.edits_xacro`;
+:class:`~ar3cli.urdf.xacro_edits.XacroDocument`) and refuses it otherwise, builds the new bytes, checks they still parse,
 prints a diff (``--diff``), reports (``--check``), or writes atomically in place or to ``-o``,
 verifies the written file (``--verify``), and renders one table or one JSON document.
 """
@@ -89,6 +90,10 @@ class Fixer(Generic[Options]):
                                                                                           kw_only=True)
     """Wraps the run, for a fixer that needs more than its options: it may adjust the shared
     arguments (it yields the ones to use) and clean up after the run, whatever its end."""
+    edits_xacro: bool = field(default=False, kw_only=True)
+    """The fixer edits text values (a URI, a limit) and asks :meth:`~ar3cli.urdf.edits.Document.refusal`
+    before each edit, so it can fix a ``.xacro`` source where the value is literal text there; the
+    others refuse xacro (their values are computed from the whole model)."""
 
     def run(self, options: Options, args: FixerArgs) -> int:
         """Run this fixer with ``options`` (an instance of :attr:`options`) on ``args``; the exit code."""
@@ -109,6 +114,15 @@ class FixerArgs:
     follow_symlinks: bool = False
     package_path: list[str] | None = None
     format: OutputFormat = OutputFormat.text
+    xacro_arg: list[str] | None = None
+    xacro_trusted: bool = False
+    xacro_env: list[str] | None = None
+
+    def specs(self) -> tuple[dict, dict]:
+        """(packages, xacro arguments) parsed, the xacro mode made this run's policy (UserError when malformed)."""
+        from ar3cli.urdf.loading import read_specs
+
+        return read_specs(self.package_path, self.xacro_arg, self.xacro_trusted, self.xacro_env)
 
     @property
     def writes(self) -> bool:
@@ -194,15 +208,16 @@ def number(value: float) -> str:
     return "0" if text in ("-0", "0") else text
 
 
-def refuse_xacro(paths: list[Path]) -> None:
+def refuse_xacro(fixer: Fixer, paths: list[Path]) -> None:
+    """A fixer whose values are computed from the whole model (not :attr:`Fixer.edits_xacro`) refuses xacro."""
     from ar3cli.urdf.file_kind import is_xacro
 
     for path in paths:
-        if is_xacro(path):
-            raise UserError(f"{path}: is a xacro file; fixing the generated URDF would not fix the source. "
-                            f"To see what to change in the .xacro, expand it (xacro {path.name} > robot.urdf) "
-                            "and run this command on robot.urdf with --diff; 'ar3cli lint-urdf' reads the "
-                            ".xacro directly")
+        if is_xacro(path) and not fixer.edits_xacro:
+            raise UserError(f"{path}: is a xacro file, and {fixer.name} computes values xacro may write from "
+                            f"expressions, so it fixes URDF only. To see what to change in the .xacro: ar3cli expand "
+                            f"{path.name} -o robot.urdf, then ar3cli {fixer.name} robot.urdf --diff; 'ar3cli "
+                            "lint-urdf' reads the .xacro directly")
 
 
 def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: bool = False) -> int:
@@ -215,21 +230,25 @@ def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: 
     fixer that has a verify step), a fix whose PyBullet check fails is not written (see
     :func:`settle_verification`).
     """
-    from ar3cli.urdf.loading import load_with_specs
+    from ar3cli.urdf.model import load_model
+    from ar3cli.urdf.xacro_edits import XacroDocument
 
-    output, package_path = args.output, args.package_path
+    output = args.output
     verifier = fixer.verify if verify else None
     if not args.paths:
         raise UserError("give at least one file")
     if output is not None and len(args.paths) != 1:
         raise UserError("-o/--output takes exactly one input file")
-    refuse_xacro(args.paths)
+    refuse_xacro(fixer, args.paths)
+    packages, xacro_args = args.specs()
     planned: list[tuple[FixResult, bytes, Any]] = []
     for path in args.paths:
-        model = load_with_specs(path, package_path, None)
-        document = Document(model.source_bytes)
+        model = load_model(path, packages, xacro_args)
+        document = XacroDocument(model) if model.is_xacro else Document(model.source_bytes)
         document.bind(model.root)
         plan = fixer.plan(model, document, options)
+        for item in (*plan.changes, *plan.skipped):
+            item.line = document.user_line(item.line)
         new = document.apply()
         result = FixResult(path, plan, changed=new != model.source_bytes)
         if result.changed:
@@ -237,7 +256,7 @@ def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: 
         if args.diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
         if result.changed:
-            result.remaining = remaining_findings(path, new, package_path)
+            result.remaining = remaining_findings(path, new, packages, xacro_args)
         planned.append((result, new, model))
     writing = args.writes
     if writing:
@@ -249,8 +268,10 @@ def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: 
             continue
         target = output or result.path
 
-        def validate(temp: Path, result: FixResult = result, original: Any = original) -> None:
-            new_model = load_with_specs(temp, package_path, None)
+        def validate(temp: Path, result: FixResult = result, original: Any = original, new: bytes = new) -> None:
+            # a xacro is expanded from the new bytes in place of the file: its includes are found beside it
+            new_model = load_model(result.path if original.is_xacro else temp, packages, xacro_args,
+                                   source=new if original.is_xacro else None)
             if verifier is not None and result.plan.changes:
                 result.verification = settle_verification(verifier(new_model, result.plan), original)
                 if result.verification["status"] == "failed":
@@ -303,14 +324,13 @@ def pybullet_load_error(model: Any) -> str | None:
     return None
 
 
-def remaining_findings(path: Path, data: bytes, package_path: list[str] | None) -> dict[str, Any]:
+def remaining_findings(path: Path, data: bytes, packages: dict, xacro_args: dict) -> dict[str, Any]:
     """A static lint of the fixed bytes (nothing is written for it): what is left to do."""
     from ar3cli.lint.engine import LintOptions, lint_model
     from ar3cli.urdf.model import load_model
-    from ar3cli.urdf.packages import parse_package_paths
 
-    options = LintOptions(package_paths=parse_package_paths(package_path))
-    findings = lint_model(load_model(path, options.package_paths, source=data), str(path), options.rules(), options).findings
+    options = LintOptions(package_paths=packages, xacro_args=xacro_args)
+    findings = lint_model(load_model(path, packages, xacro_args, source=data), str(path), options.rules(), options).findings
     counts = {severity: sum(f.severity.value == severity for f in findings) for severity in ("error", "warning", "info")}
     return {**counts, "rules": sorted({f.rule for f in findings})}
 

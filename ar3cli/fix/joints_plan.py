@@ -106,9 +106,9 @@ def plan_joints(model, document: Document, options: JointsOptions) -> FixPlan:
     for joint in model.joints:
         path = _path(joint.element)
         if path in flagged[INVERTED] or path in flagged[DEGREES]:
-            _fix_range(document, plan, joint, swap=path in flagged[INVERTED], degrees=path in flagged[DEGREES])
-        if path in flagged[INVERTED]:
-            swapped.append(joint.name)
+            fixed = _fix_range(document, plan, joint, swap=path in flagged[INVERTED], degrees=path in flagged[DEGREES])
+            if fixed and path in flagged[INVERTED]:
+                swapped.append(joint.name)
         if path in flagged[AXIS_ZERO]:
             axis = joint.element.find("axis")
             plan.skipped.append(Skipped(
@@ -145,8 +145,9 @@ def _record(plan: FixPlan, joint, **values) -> None:
     plan.context["joints"].setdefault(joint.name, {}).update(values)
 
 
-def _fix_range(document: Document, plan: FixPlan, joint, *, swap: bool, degrees: bool) -> None:
-    """Swap (J003) and/or convert to radians (J005) the joint's lower/upper."""
+def _fix_range(document: Document, plan: FixPlan, joint, *, swap: bool, degrees: bool) -> bool:
+    """Swap (J003) and/or convert to radians (J005) the joint's lower/upper; False when the source
+    cannot be edited (a xacro expression: reported as not fixed)."""
     limit = joint.limit
     texts = {key: limit.element.get(key) for key in ("lower", "upper")}
     values = {"lower": limit.lower, "upper": limit.upper}
@@ -161,8 +162,12 @@ def _fix_range(document: Document, plan: FixPlan, joint, *, swap: bool, degrees:
                 values[key] = math.radians(values[key])
                 texts[key] = number(values[key])
         reasons.append(f"{DEGREES}: degrees, converted to radians (x pi/180)")
-    span = document.span(limit.element)
     line = limit.element.sourceline or joint.line
+    refused = document.refusal(limit.element, ("lower", "upper"))
+    if refused is not None:
+        plan.skipped.append(Skipped(_element(joint), line, refused))
+        return False
+    span = document.span(limit.element)
     for key in ("lower", "upper"):
         old, new = limit.element.get(key), texts[key]
         if new is None or old == new or (not swap and same_numbers(old, new, rel_tol=SAME_NUMBER)):
@@ -170,6 +175,7 @@ def _fix_range(document: Document, plan: FixPlan, joint, *, swap: bool, degrees:
         document.set_attribute(span, key, new)
         plan.changes.append(Change(_element(joint), line, f"limit {key}", old, new, "; ".join(reasons)))
     _record(plan, joint, lower=values["lower"], upper=values["upper"])
+    return True
 
 
 def _origin_to_radians(document: Document, plan: FixPlan, joint) -> None:
@@ -202,6 +208,10 @@ def _normalise_axis(document: Document, plan: FixPlan, joint) -> None:
     old = axis.get("xyz")
     if old == new:
         return
+    refused = document.refusal(axis, ("xyz",))
+    if refused is not None:
+        plan.skipped.append(Skipped(_element(joint), axis.sourceline or joint.line, refused))
+        return
     document.set_attribute(document.span(axis), "xyz", new)
     plan.changes.append(Change(_element(joint), axis.sourceline or joint.line, "axis xyz", old, new,
                                f"{AXIS_NOT_UNIT}: length {norm:.6g}, normalised"))
@@ -214,6 +224,10 @@ def _fill_effort_velocity(document: Document, plan: FixPlan, joint, options: Joi
     entry = (options.limits or {}).get(joint.name)
     source = options.limits_path.name if options.limits_path else "joint_limits.yaml"
     line = limit.element.sourceline or joint.line
+    refused = document.refusal(limit.element, ("effort", "velocity"))
+    if refused is not None:
+        plan.skipped.append(Skipped(_element(joint), line, refused))
+        return
     span = document.span(limit.element)
     for key in ("effort", "velocity"):
         if limit.element.get(key) is not None:
@@ -274,6 +288,7 @@ def _checks_in_pybullet(model, joints: dict) -> list[dict]:
 
 
 FIXER = Fixer[JointsOptions]("fix-joints", plan_joints, verify, options=JointsOptions, timeout=DEFAULT_TIMEOUT_S,
+                             edits_xacro=True,
                              help="""\
 Fix the joint findings of lint-urdf that have one right answer, byte for byte, atomically.
 

@@ -1,7 +1,8 @@
 """The fix-mesh-paths fixer: mesh and texture URIs that work on one machine become ``package://``.
 
 Absolute paths, ``file://`` URIs, ``package:///`` URIs (an empty package name, G002) and paths
-relative to the robot file are rewritten to ``package://NAME/<path relative to DIR>`` for the
+relative to the robot file, and ``package://X/...`` URIs found only by PyBullet's fallback search
+(X is no package ROS can find: lint-urdf's G009) are rewritten to ``package://NAME/<path relative to DIR>`` for the
 ``--package NAME=DIR`` whose DIR holds the file the URI points to (the deepest such DIR). Which
 file that is, is the model's resolver's answer (:mod:`ar3cli.urdf.packages`, the one every
 command uses). ``package:///REST`` is read as ``package://REST`` (its first folder naming the
@@ -11,7 +12,7 @@ the file (PyBullet's reading).
 Every rewritten URI is resolved again by a fresh resolver that knows only ``NAME=DIR`` (no
 ROS_PACKAGE_PATH, no fallback search counted), and must give the same file, else the element is
 left alone and reported. URIs that do not resolve, or point outside every DIR, are reported as
-not fixed with the reason. ``package://NAME/...`` URIs with a package name are left alone.
+not fixed with the reason. Other ``package://NAME/...`` URIs are left alone.
 
 :func:`verify` loads the written file in PyBullet and checks that every rewritten mesh was
 loaded from the file the old URI pointed to.
@@ -106,7 +107,7 @@ def plan_mesh_paths(model, document: Document, options: MeshPathOptions) -> FixP
              for name, folder in options.packages.items()}
     for element in model.root.iter(*FILENAME_ELEMENTS):
         uri = element.get("filename")
-        kind = uri_kind(uri or "")
+        kind = uri_kind(uri or "") or _pybullet_only(model, uri or "")
         if kind is None:
             continue
         where, line = describe(element), element.sourceline or 0
@@ -116,6 +117,8 @@ def plan_mesh_paths(model, document: Document, options: MeshPathOptions) -> FixP
             continue
         target = resolution.path.resolve()
         owner = _owner(target, folders)
+        if owner is None and kind == PYBULLET_ONLY:
+            continue  # package://X/... of a package outside the ones given: X may be a package ROS finds
         if owner is None:
             given = ", ".join(f"{name}={folder}" for name, folder in options.packages.items())
             shown = uri.strip() if Path(uri.strip()) == target else f"{uri.strip()} is {target}"
@@ -131,12 +134,27 @@ def plan_mesh_paths(model, document: Document, options: MeshPathOptions) -> FixP
                                                      f"--package-path {name}={options.packages[name]} (got {got}); "
                                                      "left as it is"))
             continue
+        refused = document.refusal(element, ("filename",), same_for_every_use=True)
+        if refused is not None:
+            plan.skipped.append(Skipped(where, line, refused))
+            continue
         document.set_attribute(document.span(element), "filename", new)
         plan.changes.append(Change(where, line, f"{element.tag} filename", uri, new,
                                    f"{kind} path, file under --package {name}"))
         plan.context["meshes"].append({"element": where, "tag": element.tag, "link": _link_name(element),
                                        "role": _role(element), "file": str(target)})
     return plan
+
+
+PYBULLET_ONLY = "pybullet-only package://"
+"""The kind of a ``package://X/...`` URI that only PyBullet's fallback search finds (G009)."""
+
+
+def _pybullet_only(model, uri: str) -> str | None:
+    """:data:`PYBULLET_ONLY` when ``uri`` is ``package://X/...`` and only PyBullet's fallback search finds it."""
+    if not uri.strip().startswith("package://"):
+        return None
+    return PYBULLET_ONLY if model.resolver.resolve(uri).via == "pybullet-search" else None
 
 
 def _resolve(model, uri: str, kind: str):
@@ -232,11 +250,12 @@ def _real(name: bytes) -> str:
 
 
 FIXER = Fixer[MeshPathOptions]("fix-mesh-paths", plan_mesh_paths, verify, options=MeshPathOptions,
-                                timeout=DEFAULT_TIMEOUT_S, session=with_packages, help="""\
+                                timeout=DEFAULT_TIMEOUT_S, session=with_packages, edits_xacro=True, help="""\
 Rewrite machine-bound mesh and texture URIs to `package://NAME/...`, byte for byte, atomically.
 
-Absolute paths, `file://` URIs, `package:///` URIs (no package name) and paths relative to
-the URDF are rewritten when the file they point to lies under a --package DIR, after checking
+Absolute paths, `file://` URIs, `package:///` URIs (no package name), paths relative to the
+URDF and `package://X/...` URIs only PyBullet's fallback search finds (G009) are rewritten
+when the file they point to lies under a --package DIR, after checking
 that the new URI resolves to the same file with `--package-path NAME=DIR`. URIs that do not
 resolve, or point outside every DIR, are reported and left alone.
 """)

@@ -144,6 +144,10 @@ def summary_lines(summary: Summary) -> list[str]:
     detail = (f"; {_count(len(massless), 'link')} counted as 0: " + _names([f"{link.name} ({link.mass_note})"
                                                                     for link in massless])) if massless else ""
     lines.append(f"total mass {summary.total_mass:.4g} kg{detail}")
+    floating, fixed = summary.pybullet_mass(fixed_base=False), summary.pybullet_mass(fixed_base=True)
+    if floating != summary.total_mass or fixed != summary.total_mass:
+        lines.append(f"PyBullet simulates {floating:.4g} kg floating, {fixed:.4g} kg with a fixed base (1 kg for each link "
+                     "without <inertial>; a fixed base weighs 0)")
     root = summary.roots[0] if len(summary.roots) == 1 else "the root link"
     if summary.centre_of_mass is not None:
         lines.append(f"centre of mass at the zero configuration: {_point(summary.centre_of_mass)} m "

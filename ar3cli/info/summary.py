@@ -34,6 +34,8 @@ QUICK_MESH_SUFFIXES = (".stl", ".obj")
 MULTI_DOF_TYPES = ("floating", "planar", "spherical")
 
 NO_INERTIAL = "no inertial"
+PYBULLET_DEFAULT_MASS = 1.0
+"""kg PyBullet gives a link without ``<inertial>`` (``UrdfParser.cpp`` parseLink), except one named ``world`` (0)."""
 NO_MASS = "no <mass>"
 BAD_MASS = "mass is not a finite number"
 
@@ -146,6 +148,21 @@ class Summary:
         """Sum of the ``<mass>`` values; links without one count 0."""
         return math.fsum(link.mass for link in self.links if link.mass is not None)
 
+    def pybullet_mass(self, fixed_base: bool) -> float:
+        """The total mass PyBullet simulates: each link without ``<inertial>`` weighs
+        :data:`PYBULLET_DEFAULT_MASS` (one named ``world`` 0), and with ``useFixedBase`` the base (the
+        root link) weighs 0 whatever the file says (measured, ``docs/pybullet-facts.md`` section 1)."""
+        root = self.roots[0] if len(self.roots) == 1 else None
+        masses = []
+        for link in self.links:
+            if fixed_base and link.name == root:
+                continue
+            if link.mass is not None:
+                masses.append(link.mass)
+            elif link.mass_note == NO_INERTIAL and link.name != "world":
+                masses.append(PYBULLET_DEFAULT_MASS)
+        return math.fsum(masses)
+
     @property
     def massless_links(self) -> list[LinkInfo]:
         return [link for link in self.links if link.mass_note]
@@ -161,6 +178,7 @@ class Summary:
             "link_count": len(self.links), "joint_count": len(self.joints), "dof": self.dof,
             "movable_joint_count": len(self.movable_joints),
             "total_mass_kg": self.total_mass,
+            "pybullet_mass_kg": {"floating": self.pybullet_mass(False), "fixed_base": self.pybullet_mass(True)},
             "links_without_mass": [{"link": link.name, "why": link.mass_note} for link in self.massless_links],
             "centre_of_mass_m": _finite_list(self.centre_of_mass),
             "bounding_box_m": self.bounding_box.to_dict() if self.bounding_box else None,

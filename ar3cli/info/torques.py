@@ -124,9 +124,17 @@ class _Needed:
 
 
 def gravity_torques(model: Model, samples: int = DEFAULT_SAMPLES, seed: int = 0) -> TorqueCheck:
-    """The torque check of ``model`` (see the module doc); UserError for what it cannot handle."""
+    """The torque check of ``model`` (see the module doc); UserError for what it cannot handle. A collision
+    mesh pybullet cannot load (a file not found) is left out with one warning line: the masses come from
+    the file's ``<inertial>`` elements, not from meshes."""
+    from ar3cli.output.report import log
+    from ar3cli.sim.loadable_copy import left_out_summary, unloadable_shapes
     from ar3cli.sim.session import run_pybullet
 
+    left_out = unloadable_shapes(model, roles=("collision",))
+    if left_out:
+        log(f"info: warning: {model.path}: {left_out_summary(left_out)}: pybullet cannot load it; "
+            "gravity torques do not depend on meshes (the masses are the file's <inertial>)")
     result = run_pybullet(lambda: _compute(model, samples, seed), model)
     check = TorqueCheck(samples=samples if result.names else 0, seed=seed,
                         limit_configurations=result.limit_configurations)
@@ -150,7 +158,7 @@ def _compute(model: Model, samples: int, seed: int) -> _Needed:
     from ar3cli.sim.session import Session
 
     with Session(gravity=GRAVITY) as session:
-        body = session.load(model, fixed_base=True, visuals=False)
+        body = session.load(model, fixed_base=True, visuals=False, leave_out_unloadable=True)
         p, client = session.p, session.client
         multi = [joint.name for joint in body.joints if joint.urdf_type in ("spherical", "planar", "floating")
                  and p.getJointInfo(body.id, joint.index, physicsClientId=client)[2] != p.JOINT_FIXED]

@@ -41,6 +41,39 @@ Result = TypeVar("Result")
 DEFAULT_STAGE = "running it"
 _stage_pipe: BinaryIO | None = None
 """In an isolated child: where :func:`report_stage` writes. None everywhere else."""
+SLOW_FIRST_S = 2.0
+"""An isolated child still working after this long is announced (:func:`announce_slow_work`)..."""
+SLOW_EVERY_S = 10.0
+"""...and again every this many seconds: one line each, never a flood in a CI log."""
+_announce: Callable[[str], None] | None = None
+
+
+def announce_slow_work(say: Callable[[str], None] | None) -> None:
+    """From now on, ``say`` a line when an isolated child works longer than :data:`SLOW_FIRST_S`
+    (``robot.urdf: still simulating it (2 s)``), and every :data:`SLOW_EVERY_S` after: a command
+    whose single step can take long (lint-urdf --sim on a humanoid: ~7 s) is then not silent off a
+    terminal. None turns it off. Forked workers inherit it."""
+    global _announce
+    _announce = say
+
+
+def _slow_note(subject: str) -> Callable[[list[bytes]], None] | None:
+    """The ``tick`` of :func:`~ar3cli.infra.outcome.read_until` that announces slow work, or None."""
+    if _announce is None:
+        return None
+    import time
+
+    started = time.monotonic()
+    due = [started + SLOW_FIRST_S]
+    say = _announce
+
+    def tick(chunks: list[bytes]) -> None:
+        now = time.monotonic()
+        if now >= due[0]:
+            due[0] = now + SLOW_EVERY_S
+            say(f"{subject}: still {_messages(b''.join(chunks))[1]} ({now - started:.0f} s)")
+
+    return tick
 
 
 class CrashError(UserError):
@@ -98,7 +131,8 @@ def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], s
             child = _start(work, folder, mask)
         if meanwhile is not None:
             meanwhile()
-        data, finished = read_until(child[1].fileno(), None if seconds is None else time.monotonic() + seconds)
+        data, finished = read_until(child[1].fileno(), None if seconds is None else time.monotonic() + seconds,
+                                    _slow_note(subject))
         answer, stage = _messages(data)
         if not finished:
             raise ChildTimeoutError(f"{subject}: timed out after {seconds:g} s while {stage}; raise --timeout "

@@ -69,23 +69,32 @@ def unwrap(outcome: Outcome, where: str = "") -> Any:
 
 
 WRITER_GRACE_S = 0.5
+TICK_S = 1.0
+"""Seconds between two calls of :func:`read_until`'s ``tick`` while it waits."""
 
 
-def read_until(fd: int, deadline: float | None) -> tuple[bytes, bool]:
+def read_until(fd: int, deadline: float | None,
+               tick: Callable[[list[bytes]], None] | None = None) -> tuple[bytes, bool]:
     """Everything written to the pipe ``fd`` until its end, or until ``deadline``
     (``time.monotonic()``; None: no limit) passes with nothing more to read: (the bytes, whether
     the end was reached). A writer still writing is not cut off while its data keeps coming: once
     something came, each wait lasts at least :data:`WRITER_GRACE_S` (a large answer fills the pipe,
-    and the writer must be scheduled again to write the rest)."""
+    and the writer must be scheduled again to write the rest). ``tick(chunks so far)`` is called at
+    least every :data:`TICK_S` while waiting (a note that the work is slow)."""
     import select
 
     chunks: list[bytes] = []
     while True:
-        if deadline is not None:
-            wait = max(WRITER_GRACE_S if chunks else 0.0, deadline - time.monotonic())
+        if deadline is not None or tick is not None:
+            left = None if deadline is None else max(WRITER_GRACE_S if chunks else 0.0, deadline - time.monotonic())
+            wait = left if tick is None else TICK_S if left is None else min(left, TICK_S)
             ready, _, _ = select.select([fd], [], [], wait)
+            if tick is not None:
+                tick(chunks)
             if not ready:
-                return b"".join(chunks), False
+                if deadline is not None and time.monotonic() >= deadline:
+                    return b"".join(chunks), False
+                continue
         chunk = os.read(fd, 1 << 16)
         if not chunk:
             return b"".join(chunks), True

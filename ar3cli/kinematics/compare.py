@@ -76,6 +76,8 @@ class Comparison:
     links: list[LinkError]
     notes: list[str] = field(default_factory=list)
     reference: dict[str, np.ndarray] = field(default_factory=dict)
+    left_out: list = field(default_factory=list)
+    """The shapes loaded without (:class:`~ar3cli.sim.loadable_copy.LeftOut`: a mesh not found); frames need no mesh."""
 
 
 def draw_samples(model: Model, body, count: int, seed: int) -> Samples:

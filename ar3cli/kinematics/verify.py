@@ -88,18 +88,29 @@ class DhCheck:
 
 
 def measure(model: Model, samples: int, seed: int, announce: bool) -> tuple[fk_compare.Samples, fk_compare.Comparison]:
-    """Draw the configurations and compare pybullet's frames with the URDF FK (in a forked child)."""
+    """Draw the configurations and compare pybullet's frames with the URDF FK (in a forked child).
+
+    A collision mesh pybullet cannot load (a file not found) is left out with one warning line: link
+    frames do not depend on meshes (``Comparison.left_out`` lists it)."""
+    from ar3cli.sim.loadable_copy import left_out_summary, unloadable_shapes
     from ar3cli.sim.session import Session, run_pybullet
+
+    left_out = unloadable_shapes(model, roles=("collision",))
+    if left_out:
+        log(f"fk-verify: warning: {model.path}: {left_out_summary(left_out)}: pybullet cannot load it; "
+            "link frames do not depend on meshes")
 
     def in_pybullet() -> tuple[fk_compare.Samples, fk_compare.Comparison]:
         with Session() as session:
-            body = session.load(model, fixed_base=True, visuals=False)
+            body = session.load(model, fixed_base=True, visuals=False, leave_out_unloadable=True)
             drawn = fk_compare.draw_samples(model, body, samples, seed)
             if announce:
                 log(f"fk-verify: {samples} samples, seed {seed}")
             return drawn, fk_compare.compare(model, body, drawn)
 
-    return run_pybullet(in_pybullet, model)
+    drawn, comparison = run_pybullet(in_pybullet, model)
+    comparison.left_out = left_out
+    return drawn, comparison
 
 
 def check_dh(table: dh_module.DHTable, dh_path: Path, drawn: fk_compare.Samples,
@@ -152,6 +163,7 @@ def fk_report(model: Model, path: Path, samples: int, seed: int, tolerance: Tole
         "worst": {"link": worst.link, "sample": worst.worst_sample,
                   "configuration": drawn.configuration(worst.worst_sample)},
         "notes": comparison.notes, "dh": dh.data if dh else None,
+        "left_out": [item.to_dict() for item in comparison.left_out],
     }
     link_table = _error_table(
         f"PyBullet link frames vs URDF FK: {model.path.name}, {samples} samples, seed {seed}", "link",
@@ -159,8 +171,9 @@ def fk_report(model: Model, path: Path, samples: int, seed: int, tolerance: Tole
           "pass" if tolerance.link_passes(e) else "fail"] for e in links],
         caption="pybullet reports link frames in single precision: ~1e-7 m / ~6e-7 rad is its floor")
     lines = [f"note: {note}" for note in comparison.notes] + (dh.lines if dh else [])
-    lines.append(f"worst link: {worst.link} (sample {worst.worst_sample}: "
-                 f"{_configuration(drawn.configuration(worst.worst_sample))})")
+    worst_at = drawn.configuration(worst.worst_sample)
+    lines.append(f"worst link: {worst.link} " + (f"(sample {worst.worst_sample}: {_configuration(worst_at)})" if worst_at
+                                                 else "(no movable joint: every sample is the same configuration)"))
     scaled = (f", up to {largest:.3g} m at {max(e.max_reach for e in links):.3g} m reach"
               if largest > tolerance.position else "")
     lines.append(f"{'PASS' if passed else 'FAIL'}: max position error {max_position:.3g} m (tolerance "

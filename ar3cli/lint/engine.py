@@ -271,6 +271,10 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
                 findings += run(lambda selected=selected: _run_rules(model, shown, selected, options), model)
             except CrashError as exc:
                 error = exc.message
+        if simulated and in_mujoco:
+            from ar3cli.lint.rules.mujoco import merge_home_contacts
+
+            findings = merge_home_contacts(findings)
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
 

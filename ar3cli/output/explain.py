@@ -5,7 +5,7 @@ from __future__ import annotations
 import textwrap
 
 _SHOWN_FIRST = ("code", "name", "severity", "title", "why", "fix", "bad", "good", "needs_sim", "family", "anchor",
-                "url")
+                "doc")
 _PARAGRAPHS = {"why": "Why it matters", "fix": "Fix", "fixed_by": "Fixed by", "thresholds": "Thresholds",
                "references": "References"}
 
@@ -30,5 +30,5 @@ def explain_text(document: dict) -> str:
     for key, label in (("bad", "Failing example"), ("good", "Passing example")):
         if document.get(key):
             out += [f"{label}:", textwrap.indent(document[key].rstrip("\n"), "  "), ""]
-    out.append(f"Docs: {document['url']}")
+    out.append(f"Docs: {document['doc']} in ar3cli's source")
     return "\n".join(out) + "\n"

@@ -6,12 +6,11 @@ import os
 from pathlib import Path
 from typing import Any
 
-from ar3cli import __version__
+from ar3cli import RULES_DOC, __version__
 from ar3cli.findings import Finding, Severity
 from ar3cli.output.lint_report import rule_groups
 
 SCHEMA = "https://json.schemastore.org/sarif-2.1.0.json"
-RULES_URL = "https://github.com/ar3cli/ar3cli/blob/main/docs/rules.md"
 LEVELS = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "note"}
 
 
@@ -40,15 +39,14 @@ def sarif_document(findings: list[Finding], rules, grouped: bool = True) -> dict
     index = {rule.code: i for i, rule in enumerate(rules)}
     driver = {
         "name": "ar3cli",
-        "version": __version__,
-        "informationUri": RULES_URL,
+        "version": __version__,  # no informationUri / helpUri: ar3cli has no hosted address (RULES_DOC)
         "rules": [{
             "id": rule.code,
             "name": rule.name,
             "shortDescription": {"text": rule.title},
             "fullDescription": {"text": rule.why},
-            "help": {"text": rule.fix},
-            "helpUri": f"{RULES_URL}#{rule.anchor}",
+            "help": {"text": rule.fix, "markdown": f"{rule.fix}\n\nDocumentation: `ar3cli lint-urdf --explain "
+                                                   f"{rule.code}`, or {RULES_DOC}#{rule.anchor} in ar3cli's source."},
             "defaultConfiguration": {"level": LEVELS[rule.severity]},
             "properties": {"family": rule.family},
         } for rule in rules],

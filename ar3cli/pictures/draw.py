@@ -21,7 +21,6 @@ from typing import Any
 from ar3cli.errors import UserError
 from ar3cli.findings import listed
 from ar3cli.infra.atomic import atomic_write
-from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 from ar3cli.urdf.model import Model
 
 CONTACT_RGBA = (0.9, 0.1, 0.1, 1.0)
@@ -40,12 +39,14 @@ class RenderResult:
     configuration: dict[str, float]
     contacts: list[tuple[str, str, float]] = field(default_factory=list)
     not_drawn: list[str] = field(default_factory=list)
+    collisions_left_out: list[dict] = field(default_factory=list)
+    """Collision shapes pybullet cannot load (:class:`~ar3cli.sim.loadable_copy.LeftOut`): their contacts are not checked."""
 
     def to_dict(self) -> dict:
         return {"path": str(self.path), "width": self.width, "height": self.height,
                 "configuration": self.configuration,
                 "contacts": [{"link_a": a, "link_b": b, "depth_m": d} for a, b, d in self.contacts],
-                "visuals_not_drawn": self.not_drawn}
+                "visuals_not_drawn": self.not_drawn, "collisions_left_out": self.collisions_left_out}
 
 
 def parse_configuration(text: str | None) -> dict[str, float]:
@@ -87,20 +88,6 @@ def showing_collision_geometry(model: Model) -> Model:
 
 
 
-def undrawable_reason(shape: Any) -> str | None:
-    """Why pybullet cannot load ``shape`` (a model Shape) as a mesh: not found, or a format it does not read."""
-    geometry = shape.geometry
-    if geometry.kind != "mesh":
-        return None
-    resolution = geometry.resolution
-    if resolution is not None and not resolution.found:
-        return f"mesh {resolution.explain()}"
-    suffix = Path((geometry.filename or "").strip()).suffix.lower()
-    if suffix not in PYBULLET_MESH_FORMATS:
-        return f"pybullet cannot load '{suffix or 'no extension'}' meshes ({geometry.filename})"
-    return None
-
-
 def drawable_visuals(model: Model) -> tuple[Model, list[str]]:
     """``model``, or a copy whose visuals pybullet cannot load are replaced, and one warning per replacement.
 
@@ -110,7 +97,12 @@ def drawable_visuals(model: Model) -> tuple[Model, list[str]]:
     """
     from lxml import etree
 
-    from ar3cli.sim.loadable_copy import user_place
+    from ar3cli.sim.loadable_copy import unloadable_mesh_reason, user_place
+
+    def undrawable_reason(shape: Any) -> str | None:
+        geometry = shape.element.find("geometry")
+        reasons = (unloadable_mesh_reason(element, model.resolver) for element in (geometry if geometry is not None else ()))
+        return next((reason for reason in reasons if reason is not None), None)
 
     broken = [(link, shape, reason) for link in model.links for shape in link.visuals
               if (reason := undrawable_reason(shape)) is not None]
@@ -182,6 +174,7 @@ def draw_views(model: Model, views: Sequence[View], configuration: Mapping[str, 
     robot. What makes every view impossible (no drawable visual, a model pybullet refuses) raises."""
     from PIL import Image
 
+    from ar3cli.sim.loadable_copy import left_out_summary, unloadable_shapes
     from ar3cli.sim.session import run_pybullet
 
     if not 16 <= width <= 4096 or not 16 <= height <= 4096:
@@ -198,6 +191,11 @@ def draw_views(model: Model, views: Sequence[View], configuration: Mapping[str, 
             collision = any(link.collisions for link in model.links)
             raise UserError(f"{model.path}: no visual geometry can be drawn ({len(warnings)} visual(s) left out, see the "
                             "warnings above); " + ("try --collision" if collision else "no link has <collision> either"))
+    left_out = unloadable_shapes(shown, roles=("collision",))
+    if left_out and warn is not None:
+        drawn = "not drawn, and " if show_collision else ""
+        warn(f"render: warning: {left_out_summary(left_out)}: pybullet cannot load it; {drawn}"
+             "contacts with it are not checked")
     cameras = [(yaw, pitch) for _output, yaw, pitch in views]
     pictures, values, contacts = run_pybullet(
         lambda: _draw(shown, configuration or {}, width, height, cameras, show_collision, show_contacts), model)
@@ -211,7 +209,8 @@ def draw_views(model: Model, views: Sequence[View], configuration: Mapping[str, 
         buffer = io.BytesIO()
         Image.fromarray(rgb).save(buffer, format="PNG")
         atomic_write(output, buffer.getvalue())
-        results.append(RenderResult(output, width, height, values, contacts, not_drawn))
+        results.append(RenderResult(output, width, height, values, contacts, not_drawn,
+                                    [item.to_dict() for item in left_out]))
     return results
 
 
@@ -226,7 +225,7 @@ def _draw(model: Model, configuration: Mapping[str, float], width: int, height: 
 
     with Session() as session:
         drawn = showing_collision_geometry(model) if show_collision else model
-        body = session.load(drawn, self_collision=SELF_COLLISION_ALL_PAIRS)
+        body = session.load(drawn, self_collision=SELF_COLLISION_ALL_PAIRS, leave_out_unloadable=True)
         joints = {joint.name: joint for joint in body.actuated_joints}
         unknown = sorted(set(configuration) - set(joints))
         if unknown:

@@ -6,13 +6,25 @@ pybullet runs only inside it (each file's ``--sim`` checks in their own forked c
 own pybullet client). At most :data:`IN_FLIGHT_PER_CPU` batches per CPU are submitted at a time,
 so the driver's memory does not grow with the dataset. ``address`` joins a running cluster
 (``ray start --head`` elsewhere; every node needs ar3cli installed and the files at the same
-paths); without it a local Ray is started with ``jobs`` CPUs and shut down at the end.
+paths); without it a local Ray is started with ``jobs`` CPUs and shut down at the end (``address=
+"local"``: a cluster running on this machine is not joined by accident).
+
+Joining a cluster (measured with Ray 2.60): ``ray start --head`` enables token authentication by
+default and keeps the token in ``~/.ray/auth_token``, but a driver given an explicit address never
+turns authentication on by itself, so it was refused ("InvalidAuthToken") after 21 s of C++ warnings;
+:func:`join_settings` asks for token mode when a token is at hand (Ray's own rule for a local
+cluster) and never overrides an ``RAY_AUTH_MODE`` the user set. An address nobody listens on took
+Ray 3.5 minutes of warnings: it is tried first with a plain TCP connection (:func:`check_reachable`),
+and Ray's own output while it starts is kept off the terminal and quoted only when it fails.
 """
 
 from __future__ import annotations
 
 import importlib.util
+import os
+import socket
 from collections.abc import Iterator
+from pathlib import Path
 
 from ar3cli.errors import UserError
 from ar3cli.scan.record import Row
@@ -22,6 +34,50 @@ IN_FLIGHT_PER_CPU = 2
 MAX_BATCH = 32
 """Files per task at most (a static check is ~2 ms a file, a task's round trip ~5-10 ms);
 smaller scans use smaller batches so that every CPU gets work."""
+
+
+REACH_TIMEOUT_S = 5.0
+"""Seconds a TCP connection to the head may take before the address is called unreachable."""
+GCS_WAIT_S = "5"
+"""Ray's ``RAY_gcs_server_port_wait_time_s`` (attempts ~1 s apart to reach the head's GCS) unless the
+user set it: Ray's default 20 attempts made a refused token 21 s of warnings; 5 made it 7 s. The head
+already answered on TCP (:func:`check_reachable`), so 5 s is for a head still starting."""
+TOKEN_ENVIRONMENT = ("RAY_AUTH_TOKEN", "RAY_AUTH_TOKEN_PATH")
+
+
+def join_settings(address: str | None) -> None:
+    """Set what Ray reads from the environment to join ``address`` (before Ray is imported): token
+    authentication when a token is at hand and ``RAY_AUTH_MODE`` is not set, and a shorter wait
+    for the head's GCS (:data:`GCS_WAIT_S`). Nothing for a local Ray."""
+    if not address:
+        return
+    os.environ.setdefault("RAY_gcs_server_port_wait_time_s", GCS_WAIT_S)
+    if "RAY_AUTH_MODE" in os.environ:
+        return
+    token_file = Path(os.environ.get("RAY_AUTH_TOKEN_PATH") or Path.home() / ".ray" / "auth_token")
+    if os.environ.get("RAY_AUTH_TOKEN") or token_file.is_file():
+        os.environ["RAY_AUTH_MODE"] = "token"
+
+
+def check_reachable(address: str) -> None:
+    """A one-line UserError when nothing accepts a TCP connection at ``HOST:PORT`` within seconds;
+    other forms (``auto``, ``ray://...``) are left to Ray."""
+    host, separator, port = address.rpartition(":")
+    if not separator or not port.isdigit() or "://" in address:
+        return
+    try:
+        socket.create_connection((host.strip("[]") or "127.0.0.1", int(port)), timeout=REACH_TIMEOUT_S).close()
+    except OSError as exc:
+        raise UserError(f"cannot reach Ray at {address}: {exc.strerror or exc}; is a head running there "
+                        "(ray start --head --port PORT)?") from None
+
+
+def _why_ray_failed(exc: Exception, said: str) -> str:
+    """The sentence that explains a failed ``ray.init``: Ray's own exception, or what it printed."""
+    if "InvalidAuthToken" in said or "Authentication token" in said:
+        return ("the cluster wants an authentication token: run where `ray start --head` ran (~/.ray/auth_token), "
+                "or set RAY_AUTH_TOKEN to the head's `ray get-auth-token`")
+    return " ".join(str(exc).split()) or type(exc).__name__
 
 
 def require_ray() -> None:
@@ -34,22 +90,31 @@ def ray_rows(todo: dict[str, str], settings: ScanSettings, jobs: int | None, tim
              address: str | None) -> Iterator[Row]:
     """The rows of ``todo`` (absolute path -> content hash) as the cluster finishes each batch."""
     require_ray()
+    if address:
+        check_reachable(address)
+    join_settings(address)
     import logging
 
     import ray
 
+    from ar3cli.infra.fd_capture import redirected_fds
     from ar3cli.infra.process_pool import available_cpus
 
     started_here = not ray.is_initialized()
     if started_here:
         options = {"include_dashboard": False, "log_to_driver": False, "logging_level": logging.ERROR}
-        try:
-            if address:
-                ray.init(address=address, **options)
-            else:
-                ray.init(num_cpus=jobs or available_cpus(), **options)
-        except Exception as exc:  # noqa: BLE001 - any failure to start or reach Ray is the user's to fix
-            raise UserError(f"cannot start Ray{f' at {address}' if address else ''}: {exc}") from None
+        with redirected_fds((1, 2)) as said:  # Ray's C++ and Python start-up chatter
+            try:
+                if address:
+                    ray.init(address=address, **options)
+                else:
+                    ray.init(address="local", num_cpus=jobs or available_cpus(), **options)
+                failure = None
+            except Exception as exc:  # noqa: BLE001 - any failure to start or reach Ray is the user's to fix
+                failure = exc
+        if failure is not None:
+            raise UserError(f"cannot {'join' if address else 'start'} Ray{f' at {address}' if address else ''}: "
+                            f"{_why_ray_failed(failure, said.text)}") from None
     cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
     items = list(todo.items())
     size = max(1, min(MAX_BATCH, len(items) // (cpus * 4)))
@@ -70,7 +135,8 @@ def ray_rows(todo: dict[str, str], settings: ScanSettings, jobs: int | None, tim
                 rows = [Row(path, sha, settings.key, "crash", message=message) for path, sha in batch]
             yield from rows
     finally:
-        for reference in running:
-            ray.cancel(reference, force=True)
-        if started_here:
-            ray.shutdown()
+        with redirected_fds((1, 2)):
+            for reference in running:
+                ray.cancel(reference, force=True)
+            if started_here:
+                ray.shutdown()

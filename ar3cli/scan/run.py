@@ -3,8 +3,10 @@
 The driver is the store's only writer. It hashes every file, skips those whose row has the same
 hash and settings (unless ``rescan``), and commits the rows a backend streams back every
 :data:`COMMIT_ROWS` rows or :data:`COMMIT_SECONDS` seconds, whichever comes first. SIGINT and
-SIGTERM stop the workers and commit the rows already received before the command exits (130);
-SIGKILL loses only the rows not yet committed, which the next run checks again.
+SIGTERM stop the workers and commit the rows already received before the command exits (130), and a
+line says how many files are stored and that running the same command again goes on from there;
+SIGKILL loses only the rows not yet committed, which the next run checks again. Off a terminal a
+progress line every few seconds (:mod:`ar3cli.output.progress`) shows the scan is alive.
 """
 
 from __future__ import annotations
@@ -73,6 +75,7 @@ def run_scan(files: list[Path], store_path: Path, settings: ScanSettings, backen
         summary.skipped = summary.files - len(todo)
         pending: list[Row] = []
         last_commit = time.monotonic()
+        interrupted = False
         try:
             with _sigterm_interrupts(), progress_bar("scanning", len(todo), unit="files") as advance:
                 for row in _rows(todo, settings, backend):
@@ -83,13 +86,26 @@ def run_scan(files: list[Path], store_path: Path, settings: ScanSettings, backen
                         store.put(pending, time.time())
                         pending.clear()
                         last_commit = time.monotonic()
+        except KeyboardInterrupt:
+            interrupted = True
+            raise
         finally:
             with _signals_held():  # the rows received are whole: keep them, whatever stopped the run
                 store.put(pending, time.time())
+                if interrupted:
+                    _say_how_to_resume(store, store_path, sum(statuses.values()), len(todo))
     summary.checked = sum(statuses.values())
     summary.statuses = {status: statuses[status] for status in STATUSES}
     summary.seconds = time.monotonic() - started
     return summary
+
+
+def _say_how_to_resume(store: Store, store_path: Path, checked: int, todo: int) -> None:
+    """After Ctrl-C or SIGTERM: what is stored, and that the same command goes on from there."""
+    from ar3cli.output.report import log
+
+    log(f"scan: stopped: {checked} of {todo} files checked in this run; {store.count()} files are stored in "
+        f"{store_path}. Run the same command again to go on: stored files are not checked again")
 
 
 def _to_check(files: list[Path], known: dict[str, tuple[str, str]], key: str) -> dict[str, str]:

@@ -29,6 +29,19 @@ def collision_links(model: Model) -> list[str]:
             if any(shape.geometry.kind is not None for shape in link.collisions)]
 
 
+def unloadable_collision_links(model: Model) -> list[str]:
+    """Links with a collision shape pybullet cannot load (a mesh not found), in file order.
+
+    sample-collisions loads the robot without those shapes (:mod:`ar3cli.sim.loadable_copy`), so such a
+    link would seem never to touch anything: it is left out of the matrix instead. None of its pairs is
+    classified, so none is disabled (MoveIt keeps checking them); a box guessed around a mesh nobody
+    can read would be a claim about a shape ar3cli has not seen. It keeps its place in the adjacency.
+    """
+    from ar3cli.sim.loadable_copy import unloadable_shapes
+
+    return list(dict.fromkeys(item.link for item in unloadable_shapes(model, roles=("collision",))))
+
+
 def adjacent_pairs(model: Model, with_geometry: Iterable[str] | None = None) -> set[frozenset[str]]:
     """Pairs of links with geometry joined by a joint, looking through links without geometry.
 

@@ -9,12 +9,11 @@ descriptors themselves for a temporary file, and returns what was written as tex
 from __future__ import annotations
 
 import contextlib
-import os
 import re
-import sys
-import tempfile
 from collections.abc import Iterator
 from dataclasses import dataclass, field
+
+from ar3cli.infra.fd_capture import redirected_fds
 
 
 @dataclass
@@ -27,27 +26,16 @@ class Captured:
 
 @contextlib.contextmanager
 def capture_fds() -> Iterator[Captured]:
-    """Redirect fds 1 and 2 to a temp file for the block; safe to nest and exception-safe."""
+    """Redirect fds 1 and 2 to a temp file for the block (:func:`~ar3cli.infra.fd_capture.redirected_fds`);
+    safe to nest and exception-safe; the text is split into pybullet's messages."""
     captured = Captured()
-    for stream in (sys.stdout, sys.stderr):
-        with contextlib.suppress(Exception):
-            stream.flush()
-    saved = [os.dup(1), os.dup(2)]
-    with tempfile.TemporaryFile(mode="w+b") as sink:
-        try:
-            os.dup2(sink.fileno(), 1)
-            os.dup2(sink.fileno(), 2)
+    redirected = None
+    try:
+        with redirected_fds((1, 2)) as redirected:
             yield captured
-        finally:
-            for stream in (sys.stdout, sys.stderr):
-                with contextlib.suppress(Exception):
-                    stream.flush()
-            os.dup2(saved[0], 1)
-            os.dup2(saved[1], 2)
-            for fd in saved:
-                os.close(fd)
-            sink.seek(0)
-            captured.text = sink.read().decode("utf-8", "replace")
+    finally:
+        if redirected is not None:  # filled in whatever ended the block
+            captured.text = redirected.text
             captured.messages = split_bullet_messages(captured.text)
 
 

@@ -14,6 +14,11 @@ pybullet in three measured ways (``docs/pybullet-facts.md``, sections 7 and 10):
   element (every UR arm of example-robot-data, TIAGo, Talos, PR2, Romeo) and gives NaN frames to a
   link declared before its parent. The copy lists the links parent first, root first, otherwise in
   the file's order, so both cannot happen;
+- meshes pybullet cannot load (a file not found, a format it does not read): one makes pybullet refuse
+  the whole robot. By default the copy keeps them (pybullet's refusal is what lint-urdf --sim reports);
+  with ``leave_out_unloadable`` the ``<visual>`` or ``<collision>`` holding one is left out and listed
+  (:class:`LeftOut`), so that work that needs no meshes (frames, masses) goes on, and work that does
+  says what it could not check;
 - URDF 1.1 orientations: pybullet ignores ``<origin quat_xyzw>`` (measured: the frame stays
   unrotated), so each one becomes the ``rpy`` of the same rotation (full precision), the rotation
   ar3cli's own FK uses. ``<capsule>`` needs nothing: pybullet reads it as urdfdom does (radius,
@@ -35,7 +40,7 @@ from collections.abc import Iterable
 from pathlib import Path
 from typing import Any, NamedTuple
 
-from ar3cli.urdf.meshinfo import leave_out_unloadable_mesh
+from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS, leave_out_unloadable_mesh
 from ar3cli.urdf.model import Model, read_quaternion
 
 UNNAMED_ROBOT = "robot"
@@ -54,12 +59,83 @@ LineMap = dict[int, Place]
 """Line of the loadable copy -> where the element starting on it was written."""
 
 
-def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None = None) -> bytes:
+class LeftOut(NamedTuple):
+    """A ``<visual>`` or ``<collision>`` left out of the copy: pybullet cannot load its mesh."""
+
+    link: str
+    role: str
+    """``visual`` or ``collision``."""
+    reason: str
+    """``mesh meshes/link_3.stl: file not found``, or the format pybullet does not read (lint-urdf's G001
+    and G004 say where it looked and what to do)."""
+    place: Place | None
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"link": self.link, "role": self.role, "reason": self.reason,
+                "file": self.place.file if self.place else None, "line": self.place.line if self.place else None}
+
+
+def unloadable_mesh_reason(mesh: Any, resolver: Any) -> str | None:
+    """Why pybullet cannot load the geometry element ``mesh`` (a ``<mesh>``, or PyBullet's ``<cdf>``): its
+    file is not found, or a mesh format pybullet does not read (the whole robot is then refused); None
+    when it can, or when the element names no file."""
+    uri = (mesh.get("filename") or "").strip()
+    if not uri:
+        return None
+    resolution = resolver.resolve(uri)
+    if not resolution.found:
+        return f"{mesh.tag} {uri}: {resolution.problem or 'file not found'}"
+    if mesh.tag != "mesh":
+        return None
+    suffix = Path(uri).suffix.lower()
+    if suffix not in PYBULLET_MESH_FORMATS:
+        return f"pybullet cannot load '{suffix or 'no extension'}' meshes ({uri})"
+    return None
+
+
+def unloadable_shapes(model: Model, roles: Iterable[str] = ("visual", "collision")) -> list[LeftOut]:
+    """The ``<visual>``/``<collision>`` elements (of ``roles``) of ``model.root`` whose mesh pybullet cannot
+    load: what ``loadable_document(..., leave_out_unloadable=True)`` leaves out, with the user's file and line."""
+    found = _unloadable(model.root, model, set(roles))
+    places = _expansion_places(model) if found else None
+    return [LeftOut(link, role, reason, _place_in(model, places, shape)) for shape, link, role, reason in found]
+
+
+def _unloadable(root: Any, model: Model, roles: set[str]) -> list[tuple[Any, str, str, str]]:
+    """(shape element, link name, role, reason) for each shape under ``root`` whose mesh pybullet cannot load."""
+    found = []
+    for link in root.iter("link"):
+        for shape in link:
+            if shape.tag not in roles:
+                continue
+            for geometry in shape.iter("geometry"):
+                reasons = (unloadable_mesh_reason(element, model.resolver) for element in geometry)
+                reason = next((reason for reason in reasons if reason is not None), None)
+                if reason is not None:
+                    found.append((shape, link.get("name") or "", shape.tag, reason))
+                    break
+    return found
+
+
+def left_out_summary(left_out: list[LeftOut], most: int = 2) -> str:
+    """``1 collision shape left out (link 'a', robot.urdf:12: mesh x.stl: file not found)``: the first ``most``
+    and a count, for a command's one warning line."""
+    roles = sorted({item.role for item in left_out})
+    shown = [f"link '{item.link}'" + (f", {Path(item.place.file).name}:{item.place.line}" if item.place else "")
+             + f": {item.reason}" for item in left_out[:most]]
+    more = f"; and {len(left_out) - most} more" if len(left_out) > most else ""
+    plural = "s" if len(left_out) > 1 else ""
+    return f"{len(left_out)} {' and '.join(roles)} shape{plural} left out ({'; '.join(shown)}{more})"
+
+
+def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None = None,
+                      leave_out_unloadable: bool = False) -> bytes:
     """The bytes of the copy pybullet loads: absolute mesh paths, links parent-first, indented.
 
     ``visuals=False`` leaves the ``<visual>`` elements out, for work that never draws: reading the
     visual meshes is most of a load (measured on pybullet_data's panda: 0.09-0.30 s with them,
     0.014-0.028 s without). ``lines``, when given, is filled with the copy's :data:`LineMap`.
+    ``leave_out_unloadable`` leaves out each shape of :func:`unloadable_shapes` (the caller says so).
     """
     from lxml import etree
 
@@ -67,6 +143,9 @@ def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None 
     if not visuals:
         for element in list(root.iter("visual")):
             element.getparent().remove(element)
+    if leave_out_unloadable:
+        for shape, _link, _role, _reason in _unloadable(root, model, {"visual", "collision"}):
+            shape.getparent().remove(shape)
     if not root.get("name"):
         root.set("name", UNNAMED_ROBOT)  # pybullet refuses a <robot> without one ("Expected a name for robot")
     _order_links_parent_first(root, ((joint.parent, joint.child) for joint in model.joints))
@@ -100,9 +179,10 @@ def _quaternions_as_rpy(root: Any) -> None:
             element.set("rpy", " ".join(repr(angle) for angle in quat[1]))
 
 
-def write_loadable_copy(model: Model, path: Path, visuals: bool = True, lines: LineMap | None = None) -> Path:
+def write_loadable_copy(model: Model, path: Path, visuals: bool = True, lines: LineMap | None = None,
+                        leave_out_unloadable: bool = False) -> Path:
     """Write :func:`loadable_document` to ``path`` (filling ``lines``) and return it."""
-    path.write_bytes(loadable_document(model, visuals, lines))
+    path.write_bytes(loadable_document(model, visuals, lines, leave_out_unloadable))
     return path
 
 
@@ -151,10 +231,14 @@ def _expansion_places(model: Model) -> dict[int, Place] | None:
 
 def user_place(model: Model, element: Any) -> Place | None:
     """Where ``element`` of ``model.root`` was written: the file and line the user sees (None if unknown)."""
+    return _place_in(model, _expansion_places(model), element)
+
+
+def _place_in(model: Model, places: dict[int, Place] | None, element: Any) -> Place | None:
+    """:func:`user_place` with the xacro's :func:`_expansion_places` computed once by the caller."""
     line = element.sourceline
     if not line:
         return None
-    places = _expansion_places(model)
     return Place(str(model.path), line) if places is None else places.get(line)
 
 

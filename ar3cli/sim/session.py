@@ -319,6 +319,7 @@ class Session:
         maximal_coordinates: bool = False,
         allow_nan_frames: bool = False,
         visuals: bool = True,
+        leave_out_unloadable: bool = False,
     ) -> Body:
         """Load ``model`` with explicit flags; raises UserError quoting pybullet's reason on failure.
 
@@ -332,7 +333,9 @@ class Session:
         refused with a UserError, so that no command computes with NaN; ``allow_nan_frames=True``
         is for the lint rules that report exactly that. ``visuals=False`` loads without the
         ``<visual>`` elements, several times faster, for work that never draws (frames, contacts,
-        dynamics).
+        dynamics). ``leave_out_unloadable=True`` loads without the shapes whose mesh pybullet cannot load
+        (a file not found: :func:`~ar3cli.sim.loadable_copy.unloadable_shapes` lists them, for the caller's
+        warning) instead of failing: link frames and masses do not depend on meshes.
         """
         p = self.p
         refuse_what_crashes_pybullet(model)
@@ -346,7 +349,7 @@ class Session:
         elif self_collision == SELF_COLLISION_DEFAULT:
             flags |= p.URDF_USE_SELF_COLLISION
         lines: LineMap = {}
-        urdf_path = self._write_loadable_copy(model, visuals, lines)
+        urdf_path = self._write_loadable_copy(model, visuals, lines, leave_out_unloadable)
         report_stage("loading it")
         with capture_fds() as captured:
             try:
@@ -376,14 +379,15 @@ class Session:
                             "simulation of it can be trusted; see ar3cli lint-urdf")
         return body
 
-    def _write_loadable_copy(self, model: Model, visuals: bool = True, lines: LineMap | None = None) -> Path:
+    def _write_loadable_copy(self, model: Model, visuals: bool = True, lines: LineMap | None = None,
+                             leave_out_unloadable: bool = False) -> Path:
         """Write the copy pybullet loads (:mod:`ar3cli.sim.loadable_copy`) under a fresh name, filling ``lines``."""
         from ar3cli.sim.loadable_copy import write_loadable_copy
 
         # only safe characters: pybullet takes a UTF-8 path, and a file name need not be UTF-8 (byte 0xff)
         stem = re.sub(r"[^A-Za-z0-9_.-]", "_", model.path.stem.replace(".urdf", ""))
         name = f"{next(_load_counter)}_{stem}.urdf"
-        return write_loadable_copy(model, Path(self._tmp.name) / name, visuals, lines)
+        return write_loadable_copy(model, Path(self._tmp.name) / name, visuals, lines, leave_out_unloadable)
 
     def step(self, count: int = 1) -> None:
         for _ in range(count):

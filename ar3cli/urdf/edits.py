@@ -85,6 +85,16 @@ class Document:
         """The span of an lxml element (after :meth:`bind`)."""
         return self._by_path[self._tree.getpath(element)]
 
+    def refusal(self, element, attributes=(), same_for_every_use: bool = False) -> str | None:
+        """Why ``element`` cannot be edited here (reading or writing ``attributes``): never, in a file
+        whose elements are the model's; a xacro source says when the value is not literal text there
+        (:class:`~ar3cli.urdf.xacro_edits.XacroDocument`)."""
+        return None
+
+    def user_line(self, line: int) -> int:
+        """The line the user sees for the model's line ``line``: the same one here (a xacro maps it)."""
+        return line
+
     # ---- text helpers ------------------------------------------------------------------------
     def indentation(self, span: Span) -> bytes:
         """The whitespace before ``span`` on its line (empty when other text precedes it)."""

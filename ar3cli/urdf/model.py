@@ -376,6 +376,11 @@ class Model:
         return index + 1 if index >= 0 else 1
 
 
+SRDF_ELEMENTS = frozenset({"group", "group_state", "disable_collisions", "enable_collisions", "disable_default_collisions",
+                           "virtual_joint", "end_effector", "passive_joint", "link_sphere_approximation"})
+"""Elements of MoveIt's SRDF (srdfdom) that a URDF never has: a ``<robot>`` of them and no ``<link>`` is an SRDF."""
+
+
 def load_model(
     path: str | Path,
     package_paths: Mapping[str, Path] | None = None,
@@ -411,6 +416,10 @@ def load_model(
     if not isinstance(root.tag, str) or root.tag != "robot":
         raise UserError(f"{path}:{root.sourceline or 1}: root element is <{root.tag}>, expected <robot>; "
                         "is this a URDF file?")
+    semantic = [child.tag for child in root if child.tag in SRDF_ELEMENTS]
+    if semantic and root.find("link") is None:
+        raise UserError(f"{path}: is an SRDF (MoveIt's semantic description: <{semantic[0]}>, no <link>), not a URDF; "
+                        "give the URDF it describes (sample-collisions --srdf-compare reads an SRDF)")
     return Model(path=path, root=root, source_bytes=source, xml_bytes=xml_bytes,
                  is_xacro=is_xacro(path), resolver=resolver, quirks=quirks, expansion=expansion,
                  links=[_read_link(element, resolver) for element in root.findall("link")],

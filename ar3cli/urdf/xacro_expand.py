@@ -112,7 +112,8 @@ class _Expansion(NamedTuple):
 def expand(path: Path, args: dict[str, str], resolver: PackageResolver, source: bytes | None = None) -> bytes:
     """Return the expanded URDF as UTF-8 bytes (and keep its elements' :func:`origins` and
     :func:`included_files`). ``source`` stands in for the bytes of ``path`` itself (an editor's
-    unsaved buffer); the files it includes are read from disk as usual.
+    unsaved buffer, or a fixer's result checked before it is written); the files it includes are read
+    from disk as usual.
 
     The expansion runs in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`) with CPU,
     memory and wall-clock limits, under the current policy (safe mode by default,
@@ -219,6 +220,9 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
                             "of memory") from None
         if isinstance(exc, RecursionError):
             raise UserError(f"{path}: xacro error: macro recursion too deep") from None
+        known = _arg_without_default(path, exc) or _package_uri_include(path, exc)
+        if known:
+            raise UserError(f"{path}: xacro error: {known}") from None
         raise UserError(f"{path}: xacro error: {_one_line(exc)}{_arguments_hint(path, args)}") from None
     finally:
         substitution_args._eval_find = original_find
@@ -268,6 +272,57 @@ def _caused_by(exc: BaseException, kind: type[BaseException]) -> bool:
 
 _ARG_DECLARATION = re.compile(r"<xacro:arg\b[^>]*?\bname\s*=\s*[\"']([^\"']+)[\"']")
 _ARG_USE = re.compile(r"\$\(arg\s+([^\s)]+)\s*\)")
+
+
+_ARG_TAG = re.compile(r"<xacro:arg\b[^>]*>")
+
+
+def _arg_without_default(path: Path, exc: BaseException) -> str:
+    """For xacro's "xacro:arg: missing attribute 'default'": which ``<xacro:arg>`` lacks it (file:line)
+    and the true fix. xacro requires a default even for an argument given on its command line (or with
+    --xacro-arg), so passing the argument cannot help; "" for any other error."""
+    from ar3cli.infra.safe_read import read_bytes
+
+    if "xacro:arg: missing attribute 'default'" not in str(exc):
+        return ""
+    where = Path(_xacro_location() or path)
+    try:
+        text = read_bytes(where).decode("utf-8", "replace")
+    except UserError:
+        text = ""
+    for match in _ARG_TAG.finditer(text):
+        if not re.search(r"\bdefault\s*=", match.group(0)):
+            names = _ARG_DECLARATION.findall(match.group(0))
+            line = text.count("\n", 0, match.start()) + 1
+            return (f"<xacro:arg name=\"{names[0] if names else '?'}\"> at {where}:{line} has no default: xacro needs "
+                    "one even when the argument is given (--xacro-arg NAME:=VALUE does not help); add "
+                    "default=\"...\" to it")
+    return (f"an <xacro:arg> has no default (in {where}): xacro needs one even when the argument is given; "
+            "add default=\"...\" to it")
+
+
+_INCLUDE_TAG = re.compile(r"<xacro:include\b[^>]*?\bfilename\s*=\s*[\"'](package://([^/\"']+)/?([^\"']*))[\"']")
+
+
+def _package_uri_include(path: Path, exc: BaseException) -> str:
+    """For an ``<xacro:include filename="package://...">`` (xacro reads it as a relative file name and
+    fails): where it is (file:line) and the spelling xacro resolves, ``$(find PKG)/...``; "" otherwise."""
+    from ar3cli.infra.safe_read import read_bytes
+
+    inner = getattr(exc, "exc", None)
+    if not (isinstance(inner, OSError) and "package://" in str(inner.filename or "")):
+        return ""
+    where = Path(_xacro_location() or path)
+    try:
+        text = read_bytes(where).decode("utf-8", "replace")
+    except UserError:
+        return ""
+    for match in _INCLUDE_TAG.finditer(text):
+        if match.group(1) in str(inner.filename):
+            line = text.count("\n", 0, match.start()) + 1
+            return (f"<xacro:include filename=\"{match.group(1)}\"> at {where}:{line}: xacro does not resolve package:// "
+                    f"in includes (it reads it as a relative file name); write $(find {match.group(2)})/{match.group(3)}")
+    return ""
 
 
 def _arguments_hint(path: Path, given: dict[str, str]) -> str:

@@ -360,7 +360,8 @@ def _pass_through_visual(ctx, link) -> bool:
       why="""The mesh resolves only because PyBullet also looks for package://NAME/x relative to the
       URDF and in every folder above it. ROS (RViz, MoveIt, Gazebo) resolves package://NAME through
       the package index and will not find it.""",
-      fix="Use a path relative to the URDF, or make NAME a real package (a package.xml) or pass --package-path.",
+      fix="ar3cli fix-mesh-paths --package PKG=DIR rewrites the URI to package://PKG/... (PKG your package, DIR its "
+          "folder); or use a path relative to the URDF.",
       bad=_mesh_robot("package://meshes/base.stl"), good=_mesh_robot("meshes/base.stl"))
 def pybullet_only_path(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
@@ -368,7 +369,17 @@ def pybullet_only_path(ctx) -> Iterator[Hit]:
         if resolution is not None and resolution.found and resolution.via == "pybullet-search" and \
                 not geometry.filename.strip().startswith("package:///"):  # G002's (an error already)
             yield Hit(f"link '{link.name}' mesh {resolution.uri} is found only by PyBullet's fallback search; "
-                      "ROS tools will not find it", geometry.element)
+                      "ROS tools will not find it", geometry.element,
+                      hint=_pybullet_only_hint(resolution.uri))
+
+
+def _pybullet_only_hint(uri: str) -> str:
+    """G009's hint for ``uri``: which package ROS cannot find (or that the relative path is not there), and the fix."""
+    package = uri.strip()[len("package://"):].split("/")[0] if uri.strip().startswith("package://") else ""
+    what = (f"'{package}' is no package ROS can find" if package else
+            "the path is not there relative to the URDF (PyBullet finds it in a folder above)")
+    return (f"{what}: ar3cli fix-mesh-paths --package PKG=DIR rewrites the URI to package://PKG/... (PKG your "
+            "package, DIR its folder).")
 
 
 SPEC_SHAPES = ("box", "cylinder", "sphere", "mesh")

@@ -27,8 +27,6 @@ there: a rod's ratio is 6 (r/L)², 1e-9 would be a 1 m rod 13 µm thick."""
 FRAME_LINK_PHRASE = "is a frame (no geometry)"
 """I002's words for a link with neither geometry nor <inertial> on a fixed joint: fix-inertia gives such
 a frame a tiny inertial without any mass source, so ``lint-urdf --fix-hint`` asks for no --density."""
-DUMMY_ROOT_NAMES = frozenset({"world", "map", "odom", "base_footprint", "dummy", "root", "base_root"})
-"""Root link names that are frames by convention (ROS REP 105 and KDL's "no inertia on the root")."""
 
 
 def _moving_links(model) -> dict[str, object]:
@@ -499,10 +497,6 @@ def world_inertial(ctx) -> Iterator[Hit]:
                       link.inertial.element)
 
 
-def _looks_like_frame(link) -> bool:
-    return not link.has_geometry or link.name.lower() in DUMMY_ROOT_NAMES
-
-
 @rule("I012", "root-inertial-missing", "info", "Root link with geometry but no <inertial>",
       engines=("pybullet", "drake"),
       why="""This matters only if the robot floats (a mobile base, a legged robot, an object to
@@ -510,14 +504,15 @@ def _looks_like_frame(link) -> bool:
       useFixedBase=False, PyBullet gives a root without <inertial> 1 kg and I = (1, 1, 1), silently
       apart from a C-level warning; Drake makes it a massless free body, whose dynamics are
       singular. (MuJoCo's URDF import fixes the root to the world whatever its mass.)
-      Roots without geometry (world, base_footprint: frames by ROS convention, where KDL wants no
-      inertia) are not reported.""",
+      A root without geometry weighs 1 kg in PyBullet too (only one named world gets 0): a frame fixed
+      on top of a body (base_footprint, Jackal's base_link over its chassis) is reported, as the body
+      under it is most likely a mobile base; a frame an arm turns on (a moving joint) is not.""",
       fix="If the robot floats, give the root link its real <inertial> (ar3cli fix-inertia --links ROOT computes one "
           "from the geometry); if it is always fixed to the world, nothing to do.",
       bad=robot('''<link name="chassis"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
       good=robot(f'''<link name="chassis">{LINK_INERTIAL}<collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
-      thresholds="Frame roots are skipped: no visual or collision geometry, or a name in DUMMY_ROOT_NAMES "
-                 "(world, map, odom, base_footprint, dummy, root, base_root).",
+      thresholds="Skipped: a root named world (PyBullet gives it mass 0), and a root without geometry that "
+                 "is not joined to the rest by fixed joints only (an arm's mounting frame).",
       references="PyBullet UrdfParser.cpp parseLink (mass 1, inertia 1 without <inertial>); Drake "
                  "multibody/parsing/detail_urdf_parser.cc ParseBody (no <inertial>: zero spatial inertia).")
 def root_inertial_missing(ctx) -> Iterator[Hit]:
@@ -525,11 +520,15 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
     if len(roots) != 1:
         return  # no root or several: S005's business
     root = roots[0]
-    if root.inertial is None and not _looks_like_frame(root):
-        yield Hit(f"root link '{root.name}' has geometry but no <inertial>: if this robot floats, PyBullet gives it "
+    below = [joint.type for joint in ctx.model.joints if joint.parent == root.name]
+    frame_on_a_body = bool(below) and all(kind == "fixed" for kind in below)
+    if root.inertial is None and root.name != "world" and (root.has_geometry or frame_on_a_body):
+        what = "has geometry but" if root.has_geometry else "is a frame (no geometry) with"
+        fix = (f"ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write the real <inertial>)"
+               if root.has_geometry else "give it a tiny <inertial> (mass 1e-6 kg, I = 1e-12)")
+        yield Hit(f"root link '{root.name}' {what} no <inertial>: if this robot floats, PyBullet gives it "
                   "1 kg and I = 1, Drake no mass at all", root.element,
-                  hint=f"If the robot floats: ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write "
-                       "the real <inertial>); a fixed-base arm can ignore this.")
+                  hint=f"If the robot floats: {fix}; a fixed-base arm can ignore this.")
 
 
 FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,

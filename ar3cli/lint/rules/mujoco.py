@@ -9,12 +9,13 @@ messages name a link or joint ("Element name 'arm'"): the finding points at its 
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Iterator
 from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
-from ar3cli.lint.rules.pybullet_sim import unstable_hit
+from ar3cli.lint.rules.pybullet_sim import depth_text, unstable_hit
 
 SETTLE_SECONDS = 1.0
 MAX_SETTLE_SPEED = 100.0
@@ -118,8 +119,26 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
                 (a in group and group[a] == group.get(b)):
             continue
         link = ctx.model.link(b) or ctx.model.link(a)
-        yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.3g} mm at the home pose in MuJoCo",
+        yield Hit(f"links '{a}' and '{b}' interpenetrate by {depth_text(-depth)} at the home pose in MuJoCo",
                   link.element if link else None)
+
+
+def merge_home_contacts(findings: list) -> list:
+    """With ``--engine all``: one finding per pair both engines find interpenetrating at home, P002's,
+    saying MuJoCo's depth too, instead of a P002 and an M003 about the same pair and line."""
+    def pair(finding) -> tuple[str, int, str]:
+        return finding.path, finding.line, finding.message.split(" interpenetrate by ")[0]
+
+    mujoco = {pair(f): f for f in findings if f.rule == mujoco_self_collision_home.code}
+    merged, dropped = [], set()
+    for finding in findings:
+        twin = mujoco.get(pair(finding)) if finding.rule == "P002" else None
+        if twin is not None:
+            depth = twin.message.split(" interpenetrate by ")[1].split(" at the home pose")[0]
+            finding = dataclasses.replace(finding, message=f"{finding.message}; in MuJoCo too ({depth}, M003)")
+            dropped.add(id(twin))
+        merged.append(finding)
+    return [finding for finding in merged if id(finding) not in dropped]
 
 
 @rule("M004", "mujoco-unstable", "error", "NaN or exploding states in MuJoCo after 1 s under gravity",

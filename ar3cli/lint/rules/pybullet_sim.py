@@ -108,11 +108,11 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
             if a in group and group[a] == group.get(b):
                 continue  # joined only by fixed joints: they can never move apart (issue 30 item 8)
             link = ctx.model.link(b) or ctx.model.link(a)
-            yield Hit(f"links '{a}' and '{b}' interpenetrate by {_depth_text(-depth)} at the home pose",
+            yield Hit(f"links '{a}' and '{b}' interpenetrate by {depth_text(-depth)} at the home pose",
                       link.element if link else None)
 
 
-def _depth_text(depth: float) -> str:
+def depth_text(depth: float) -> str:
     """0.1 mm and deeper in mm, shallower in µm (a 4 µm overlap is not '0.0 mm')."""
     return f"{depth * 1000:.1f} mm" if depth >= 1e-4 else f"{depth * 1e6:.1f} µm"
 
@@ -269,6 +269,6 @@ def sim_passes_through_parent(ctx) -> Iterator[Hit]:
         for found in found_all:
             unit = "m" if found.joint.urdf_type == "prismatic" else "rad"
             yield Hit(f"moving joint '{found.joint.name}' to {found.value:.3g} {unit} sinks link '{found.child}' "
-                      f"{_depth_text(found.depth)} into its parent '{found.parent}' (at home: "
-                      f"{_depth_text(found.home_depth)}; threshold: {_depth_text(found.threshold)} more)",
+                      f"{depth_text(found.depth)} into its parent '{found.parent}' (at home: "
+                      f"{depth_text(found.home_depth)}; threshold: {depth_text(found.threshold)} more)",
                       found.joint.urdf.element if found.joint.urdf else None)
