@@ -174,12 +174,10 @@ def _write_baseline(path: Path, results, fmt, follow_symlinks: bool = False) -> 
 
 def explain_rule(code: str, fmt) -> None:
     """``--explain CODE``: the rule's documentation in the terminal (or as JSON), exit 0."""
-    from ar3cli import RULES_DOC
     from ar3cli.lint.engine import find_rule, rule_document
     from ar3cli.output.explain import explain_text
 
     document = rule_document(find_rule(code))
-    document["doc"] = f"{RULES_DOC}#{document['anchor']}"
     if fmt == "json":
         finish(Report(data=document), "json")
     finish(Report(data=document, text=explain_text(document)), "text")

@@ -28,3 +28,12 @@ def asset(relative: str) -> Path:
     if not path.exists():
         raise UserError(f"bundled asset {relative} is missing from {assets_dir()}")
     return path
+
+
+def rules_doc() -> Path | None:
+    """docs/rules.md, the rules' documentation: shipped in the wheel as ``ar3cli/docs/rules.md``, beside
+    the package in a source checkout; None where neither exists (nothing made up then)."""
+    for candidate in (_PACKAGE_DIR / "docs" / "rules.md", _PACKAGE_DIR.parent / "docs" / "rules.md"):
+        if candidate.is_file():
+            return candidate
+    return None

@@ -607,8 +607,11 @@ def find_rule(code: str) -> Rule:
 
 def rule_document(rule: Rule) -> dict[str, Any]:
     """Every documentation field of ``rule`` (whatever fields :class:`Rule` has, its ``check``
-    aside), plus its family and docs anchor: what ``lint-urdf --explain`` shows."""
+    aside), plus its family, docs anchor and section of docs/rules.md: what ``lint-urdf --explain``
+    and the language server's hover show."""
     import dataclasses
+
+    from ar3cli import RULES_DOC
 
     document: dict[str, Any] = {}
     for item in dataclasses.fields(rule):
@@ -618,4 +621,5 @@ def rule_document(rule: Rule) -> dict[str, Any]:
         document[item.name] = value.value if isinstance(value, Severity) else value
     document["family"] = rule.family
     document["anchor"] = rule.anchor
+    document["doc"] = f"{RULES_DOC}#{rule.anchor}"
     return document

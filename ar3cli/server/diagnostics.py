@@ -20,13 +20,19 @@ SEVERITY = {Severity.ERROR: types.DiagnosticSeverity.Error, Severity.WARNING: ty
             Severity.INFO: types.DiagnosticSeverity.Information}
 
 
-def rule_url(code: str) -> str:
-    """The rule's section of docs/rules.md (the link SARIF's ``helpUri`` gives too)."""
+def rule_url(code: str) -> str | None:
+    """The rule's section of docs/rules.md as installed with ar3cli (a ``file:`` URI an editor opens
+    offline); None for a code without a rule or where the file is missing (ar3cli has no hosted address)."""
+    from ar3cli.infra.assets import rules_doc
     from ar3cli.lint.rules import REGISTRY
-    from ar3cli.output.sarif import RULES_URL
 
-    rule = REGISTRY.get(code)
-    return f"{RULES_URL}#{rule.anchor}" if rule is not None else RULES_URL
+    rule, doc = REGISTRY.get(code), rules_doc()
+    return f"{doc.as_uri()}#{rule.anchor}" if rule is not None and doc is not None else None
+
+
+def _description(code: str) -> types.CodeDescription | None:
+    url = rule_url(code)
+    return types.CodeDescription(href=url) if url else None
 
 
 def to_range(index: LineIndex, start: int, end: int) -> types.Range:
@@ -42,7 +48,7 @@ def diagnostic(finding: Finding, index: LineIndex) -> types.Diagnostic:
     message = "\n".join(printable(line) for line in (finding.message, finding.hint) if line)
     return types.Diagnostic(
         range=to_range(index, start, end), message=message, severity=SEVERITY[finding.severity],
-        code=finding.rule, code_description=types.CodeDescription(href=rule_url(finding.rule)), source=SOURCE,
+        code=finding.rule, code_description=_description(finding.rule), source=SOURCE,
         data={"rule": finding.rule, "line": finding.line, "column": finding.column})
 
 

@@ -31,11 +31,8 @@ def explanation(code: str) -> str:
     """What ``ar3cli lint-urdf --explain CODE`` prints."""
     from ar3cli.lint.engine import find_rule, rule_document
     from ar3cli.output.explain import explain_text
-    from ar3cli.output.sarif import RULES_URL
 
-    document = rule_document(find_rule(code))
-    document["url"] = f"{RULES_URL}#{document['anchor']}"
-    return explain_text(document)
+    return explain_text(rule_document(find_rule(code)))
 
 
 def _contains(item: types.Range, position: types.Position) -> bool:
