@@ -182,3 +182,110 @@ def test_a_folder_where_no_temporary_file_can_be_made_is_one_user_error(tmp_path
     with pytest.raises(UserError, match=r"cannot write in .*Permission denied"):
         atomic_write(target, b"new")
     assert target.read_bytes() == b"old"
+
+
+# ---- package:// resolution: every candidate present, the first in the documented order wins ------------
+def _mesh(folder: Path, label: str) -> Path:
+    (folder / "meshes").mkdir(parents=True, exist_ok=True)
+    (folder / "meshes" / "m.stl").write_text(label)
+    return folder
+
+
+def test_package_search_order_with_every_candidate_present(tmp_path):
+    """--package-path, then ROS_PACKAGE_PATH's entries in order, then AMENT_PREFIX_PATH, then the nearest
+    ancestor package, then a farther one (ar3cli.urdf.packages): each removed in turn hands over to the next."""
+    import shutil
+
+    from ar3cli.urdf.packages import PackageResolver
+
+    outer, near = tmp_path / "outer", tmp_path / "outer" / "near"
+    (near / "urdf").mkdir(parents=True)
+    for folder in (outer, near):
+        (folder / "package.xml").write_text("<package><name>parts</name></package>")
+        _mesh(folder, folder.name)
+    option = _mesh(tmp_path / "option", "option")
+    ros = [_mesh(tmp_path / entry / "parts", entry) for entry in ("ros1", "ros2")]
+    ament = _mesh(tmp_path / "ament" / "share" / "parts", "ament")
+    environ = {"ROS_PACKAGE_PATH": f"{tmp_path / 'ros1'}:{tmp_path / 'ros2'}", "AMENT_PREFIX_PATH": str(tmp_path / "ament")}
+
+    def winner(package_paths: dict) -> str:
+        found = PackageResolver(near / "urdf", package_paths, environ=environ).resolve("package://parts/meshes/m.stl")
+        return found.path.read_text()
+
+    assert winner({"parts": option}) == "option"
+    for folder, label in ((ros[0], "ros1"), (ros[1], "ros2"), (ament, "ament")):
+        assert winner({}) == label
+        shutil.rmtree(folder)
+    assert winner({}) == "near"
+    (near / "package.xml").unlink()
+    assert winner({}) == "outer"
+
+
+def test_pybullet_fallback_search_takes_the_nearest_folder(tmp_path):
+    """No package anywhere: PyBullet's own search finds the file in the robot's folder before a folder above."""
+    from ar3cli.urdf.packages import PackageResolver
+
+    here = tmp_path / "a" / "b"
+    _mesh(here / "parts", "nearest")
+    _mesh(tmp_path / "a" / "parts", "above")
+    found = PackageResolver(here, {}, environ={}).resolve("package://parts/meshes/m.stl")
+    assert found.via == "pybullet-search" and found.path.read_text() == "nearest"
+    (here / "parts" / "meshes" / "m.stl").unlink()
+    assert PackageResolver(here, {}, environ={}).resolve("package://parts/meshes/m.stl").path.read_text() == "above"
+
+
+def test_xacro_find_takes_the_package_path_option_over_the_ancestor_package(tmp_path):
+    """$(find parts) in a xacro include: the --package-path folder, not the package the robot file sits in."""
+    from ar3cli.urdf.model import load_model
+
+    home = tmp_path / "parts"
+    (home / "urdf").mkdir(parents=True)
+    (home / "package.xml").write_text("<package><name>parts</name></package>")
+    other = tmp_path / "other"
+    (other / "urdf").mkdir(parents=True)
+    for folder, link in ((home, "from_ancestor"), (other, "from_option")):
+        (folder / "urdf" / "part.xacro").write_text(
+            f'<robot xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="{link}"/></robot>')
+    robot = home / "urdf" / "robot.urdf.xacro"
+    robot.write_text('<robot name="r" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+                     '<xacro:include filename="$(find parts)/urdf/part.xacro"/></robot>')
+    assert [link.name for link in load_model(robot).links] == ["from_ancestor"]
+    assert [link.name for link in load_model(robot, {"parts": other}).links] == ["from_option"]
+
+
+# ---- fix-mesh-paths: nested --package folders, the deepest owns the file ---------------------------------
+def test_mesh_paths_owner_is_the_deepest_package_whatever_the_order_given(tmp_path):
+    from ar3cli.fix.mesh_paths_plan import _owner
+
+    outer, inner = tmp_path / "ws", tmp_path / "ws" / "src" / "arm"
+    target = inner / "meshes" / "m.stl"
+    assert _owner(target, {"ws": outer, "arm": inner}) == "arm"
+    assert _owner(target, {"arm": inner, "ws": outer}) == "arm"
+    assert _owner(outer / "other.stl", {"arm": inner, "ws": outer}) == "ws"
+
+
+# ---- [tool.ar3cli.lint]: the nearest pyproject.toml ------------------------------------------------------
+def test_nearest_pyproject_configures_the_lint(tmp_path):
+    from ar3cli.lint.config import load_config
+
+    inner = tmp_path / "robots" / "arm"
+    inner.mkdir(parents=True)
+    (tmp_path / "pyproject.toml").write_text('[tool.ar3cli.lint]\nselect = ["G"]\n')
+    (tmp_path / "robots" / "pyproject.toml").write_text('[tool.ar3cli.lint]\nselect = ["J"]\n')
+    assert load_config(inner).select == ["J"]
+    assert load_config(tmp_path).select == ["G"]
+
+
+# ---- P005: the parent a child is measured against is its nearest ancestor with geometry ----------------
+def test_pass_through_parent_is_the_nearest_ancestor_with_collision_geometry(tmp_path):
+    from ar3cli.sim.pass_through import _geometric_parent
+    from ar3cli.urdf.model import load_model
+
+    chain = [("base", "mid"), ("mid", "frame"), ("frame", "tip")]
+    path = tmp_path / "robot.urdf"
+    path.write_text('<robot name="r">' + "".join(f'<link name="{name}"/>' for name in ("base", "mid", "frame", "tip"))
+                    + "".join(f'<joint name="{b}_joint" type="fixed"><parent link="{a}"/><child link="{b}"/></joint>'
+                              for a, b in chain) + "</robot>")
+    model = load_model(path)
+    assert _geometric_parent(model, "tip", {"base", "mid", "tip"}) == "mid"  # through the frame, not past mid
+    assert _geometric_parent(model, "tip", {"base", "tip"}) == "base"
