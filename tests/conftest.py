@@ -79,7 +79,7 @@ def pybullet_data_dir() -> Path:
 def shared_dir() -> Path:
     """shared/ beside the clone; tests that need it skip cleanly where it is absent."""
     if not SHARED.is_dir():
-        pytest.skip(f"shared/ folder not found at {SHARED} (it sits beside the clone in CI)")
+        pytest.skip("shared/ folder not found beside the clone (it sits there in CI)")
     return SHARED
 
 

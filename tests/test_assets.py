@@ -146,7 +146,7 @@ def test_ar3_limits(pb: int) -> None:
 def test_ar3_limits_match_real_joint_limits_yaml() -> None:
     yaml_path = REAL / "extra" / "ar3_moveit_config" / "config" / "joint_limits.yaml"
     if not yaml_path.is_file():
-        pytest.skip(f"real AR3 description not present at {REAL}")
+        pytest.skip("real AR3 description not present (shared/models/ar3_description beside the clone)")
     import yaml
 
     real = yaml.safe_load(yaml_path.read_text())["joint_limits"]
@@ -182,7 +182,7 @@ def test_kinematics_match_real_ar3_xacro() -> None:
     """Link frames equal the real ar3.urdf.xacro's (the file the kinematics come from)."""
     real_xacro = REAL / "urdf" / "ar3.urdf.xacro"
     if not real_xacro.is_file():
-        pytest.skip(f"real AR3 description not present at {REAL}")
+        pytest.skip("real AR3 description not present (shared/models/ar3_description beside the clone)")
     xacro = pytest.importorskip("xacro")
     real = _yourdfpy(io.StringIO(xacro.process_file(str(real_xacro)).toxml()))
     ours = _yourdfpy(AR3)
@@ -199,7 +199,7 @@ def test_kinematics_match_real_ar3_urdf() -> None:
     """
     real_urdf = REAL / "urdf" / "ar3.urdf"
     if not real_urdf.is_file():
-        pytest.skip(f"real AR3 description not present at {REAL}")
+        pytest.skip("real AR3 description not present (shared/models/ar3_description beside the clone)")
     real = _yourdfpy(real_urdf)
     ours = _yourdfpy(AR3)
     for q in _configurations():
