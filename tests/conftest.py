@@ -94,3 +94,52 @@ def write_urdf(tmp_path):
         return path
 
     return write
+
+
+UNPRIVILEGED_UID = 65534
+"""``nobody``: the user a root test run drops to where a check must see real permissions."""
+
+
+def as_unprivileged(work, *paths: Path) -> None:
+    """Run ``work()`` as a user the kernel really refuses writes to, whoever runs the tests.
+
+    As root (CI), permission checks pass everywhere, so ``work`` runs in a forked child that gives
+    ``paths`` to ``nobody`` and becomes ``nobody`` first; an exception in it (a failed assert) fails
+    the test with its text. As anyone else, ``work()`` runs here.
+    """
+    if os.geteuid() != 0:
+        work()
+        return
+    import traceback
+
+    for path in paths:
+        os.chown(path, UNPRIVILEGED_UID, UNPRIVILEGED_UID)
+    read, write = os.pipe()
+    pid = os.fork()
+    if pid == 0:  # the child: drop root, run, report
+        os.close(read)
+        status = 0
+        try:
+            os.setgroups([])
+            os.setgid(UNPRIVILEGED_UID)
+            os.setuid(UNPRIVILEGED_UID)
+            work()
+        except BaseException:  # noqa: BLE001 - everything goes back to the parent as text
+            os.write(write, traceback.format_exc().encode())
+            status = 1
+        os._exit(status)
+    os.close(write)
+    with os.fdopen(read, "rb") as stream:
+        failure = stream.read().decode()
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0, f"as uid {UNPRIVILEGED_UID}:\n{failure}"
+
+
+@pytest.fixture
+def open_tmp_path():
+    """A temporary folder every user may enter (pytest's own sit under a root-only 0700 folder), for
+    tests that drop to :data:`UNPRIVILEGED_UID`; removed afterwards."""
+    folder = Path(tempfile.mkdtemp(prefix="ar3cli-test-"))
+    folder.chmod(0o755)
+    yield folder
+    shutil.rmtree(folder, ignore_errors=True)

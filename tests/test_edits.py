@@ -15,7 +15,7 @@ import pytest
 from ar3cli.infra.atomic import TEMP_MARKER, atomic_write, stale_temps, temp_files
 from ar3cli.urdf.edits import Document
 from ar3cli.urdf.model import load_model
-from tests.conftest import ASSETS, REPO
+from tests.conftest import ASSETS, REPO, as_unprivileged
 
 NASTY = (
     "\ufeff<?xml version='1.0' encoding='utf-8'?>\r\n"
@@ -205,20 +205,23 @@ def test_atomic_write_follows_symlinks_when_asked_and_refuses_directories(tmp_pa
         atomic_write(tmp_path, b"x")
 
 
-def test_atomic_write_into_read_only_folder_is_a_user_error(tmp_path):
+def test_atomic_write_into_read_only_folder_is_a_user_error(open_tmp_path):
     import pytest
 
     from ar3cli.errors import UserError
 
-    (tmp_path / "ro").mkdir()
-    (tmp_path / "ro").chmod(0o500)
+    folder = open_tmp_path / "ro"
+    folder.mkdir()
+
+    def refused() -> None:
+        with pytest.raises(UserError, match="cannot write in"):
+            atomic_write(folder / "x.urdf", b"x")
+
+    folder.chmod(0o555)
     try:
-        if os.access(tmp_path / "ro", os.W_OK):
-            pytest.skip("running as a user who can write anywhere")
-        with pytest.raises(UserError, match="cannot write"):
-            atomic_write(tmp_path / "ro" / "x.urdf", b"x")
+        as_unprivileged(refused, folder)  # as root the kernel would let the write through
     finally:
-        (tmp_path / "ro").chmod(0o700)
+        folder.chmod(0o700)
 
 
 def test_atomic_write_respects_a_read_only_file(tmp_path):

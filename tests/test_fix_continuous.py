@@ -182,6 +182,7 @@ def test_fake_limits_without_effort_remove_the_whole_limit(cli, write_urdf):
     result = cli("fix-continuous", str(path))
     assert result.code == 0, result.stderr
     assert "<limit" not in path.read_text().split('name="spin"')[1].split("</joint>")[0]
+    assert path.read_text() == BARE.replace('    <limit lower="-100" upper="100"/>\n', "")  # every other byte stays
     assert not lint_findings(cli, path, "J006,J007")
     assert cli("fix-continuous", str(path), "--check").code == 0
     again = cli("fix-continuous", str(path), "--effort", "5", "--velocity", "2")  # now add real values

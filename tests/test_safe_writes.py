@@ -16,7 +16,7 @@ import pytest
 
 from ar3cli.errors import UserError
 from ar3cli.infra.atomic import atomic_write, check_writable, remove_stale_temps, stale_temps, temp_files
-from tests.conftest import ASSETS, REPO
+from tests.conftest import ASSETS, REPO, as_unprivileged
 
 ROBOT = ASSETS / "examples" / "ar3_fake_continuous.urdf"
 PRECIOUS = b"precious: must not be overwritten\n"
@@ -116,13 +116,17 @@ def test_a_file_the_caller_may_not_write_is_refused(tmp_path, monkeypatch):
     assert path.read_bytes() == b"old"
 
 
-@pytest.mark.skipif(os.geteuid() == 0, reason="as root os.access allows every write; covered by the test above")
-def test_a_group_read_only_file_of_the_caller_is_refused_for_real(tmp_path):
-    path = tmp_path / "robot.urdf"
+def test_a_group_read_only_file_of_the_caller_is_refused_for_real(open_tmp_path):
+    """No patched ``os.access``: the kernel's answer, as a user without root's rights (see as_unprivileged)."""
+    path = open_tmp_path / "robot.urdf"
     path.write_bytes(b"old")
     path.chmod(0o464)  # the group may write, the owner (the caller) may not
-    with pytest.raises(UserError, match="is read-only for you"):
-        check_writable(path)
+
+    def refused() -> None:
+        with pytest.raises(UserError, match="is read-only for you"):
+            check_writable(path)
+
+    as_unprivileged(refused, path)
 
 
 def test_an_edit_made_while_fixing_is_kept(tmp_path):
