@@ -99,7 +99,12 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
     """
     found: list[Path] = []
     for path in paths:
-        if path.is_dir():
+        try:
+            is_dir = path.is_dir()
+        except OSError:  # a name the OS refuses (a component over 255 bytes): the file's F001 says so
+            found.append(path)
+            continue
+        if is_dir:
             for folder, dirs, files in os.walk(path):
                 dirs[:] = sorted(d for d in dirs if d not in _SKIP_DIRS)
                 found += [Path(folder) / name for name in sorted(files) if name.lower().endswith(ROBOT_SUFFIXES)]
@@ -231,6 +236,10 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
         finding = load_failure(path, shown, exc.message)
     except RecursionError:
         finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - the loader's bug: this file's error line, the batch goes on
+        return LintResult(shown, False, [], f"{shown}: {internal_error('while loading it', exc)}")
     else:
         result = lint_model(model, shown, rules, options)
         if cache is not None and not model.is_xacro:
@@ -250,7 +259,7 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
     static, simulated, in_mujoco = _partition(rules)
-    findings = _run_rules(model, shown, static, options)
+    findings, failures = _run_rules(model, shown, static, options)
     error = None
     if simulated or in_mujoco:
         from ar3cli.infra.isolation import CrashError
@@ -261,9 +270,14 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
             if not selected:
                 continue
             try:
-                findings += run(lambda selected=selected: _run_rules(model, shown, selected, options), model)
+                found, failed = run(lambda selected=selected: _run_rules(model, shown, selected, options), model)
             except CrashError as exc:
                 error = exc.message
+            else:
+                findings += found
+                failures += failed
+    if failures and error is None:
+        error = f"{shown}: {failures[0]}" + (f" (and {len(failures) - 1} more rules)" if len(failures) > 1 else "")
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
     return LintResult(shown, True, findings, error)
 
@@ -284,29 +298,47 @@ def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
 _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
 
 
-def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
-    """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
+def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> tuple[list[Finding], list[str]]:
+    """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted), and one line per rule
+    that failed on this file.
+
+    A rule that raises (a value the file holds overflows a computation it did not expect, say) is a
+    bug in that rule: its findings so far are kept, the other rules still run, and the file's error
+    line names it, so one file never ends the batch (:func:`lint_model` makes it the file's error).
+    """
     context = Context(model, options.srdf_disabled)
     locator = Locator(model, shown)
     file_ignores = _file_level_ignores(model.source_bytes)
     findings: list[Finding] = []
+    failures: list[str] = []
     try:
         for rule in rules:
             if rule.check is None:
                 continue
-            for hit in rule.check(context):
-                if matches(rule.code, file_ignores) or _file_ignored(shown, rule.code, options):
-                    continue
-                if hit.element is not None and suppressed_inline(hit.element, rule.code):
-                    continue
-                path, line, column = locator.locate(hit)
-                if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
-                    continue
-                findings.append(_override(Finding(rule.code, rule.severity, hit.message, path, line, column,
-                                                  hit.hint or rule.fix), options))
+            try:
+                for hit in rule.check(context):
+                    if matches(rule.code, file_ignores) or _file_ignored(shown, rule.code, options):
+                        continue
+                    if hit.element is not None and suppressed_inline(hit.element, rule.code):
+                        continue
+                    path, line, column = locator.locate(hit)
+                    if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
+                        continue
+                    findings.append(_override(Finding(rule.code, rule.severity, hit.message, path, line, column,
+                                                      hit.hint or rule.fix), options))
+            except (UserError, MemoryError):
+                raise
+            except Exception as exc:  # noqa: BLE001 - a rule's bug: this file's error line, the batch goes on
+                failures.append(internal_error(f"in rule {rule.code}", exc) + "; the other rules ran")
     finally:
         context.close()
-    return findings
+    return findings, failures
+
+
+def internal_error(where: str, exc: BaseException) -> str:
+    """The line that says ar3cli failed on a file ``where`` (``in rule G014``): a bug to report."""
+    text = " ".join(str(exc).split())[:200]
+    return f"internal error {where} ({type(exc).__name__}{': ' + text if text else ''}), please report it"
 
 
 def load_failure(path: Path, shown: str, message: str) -> Finding:
