@@ -33,6 +33,7 @@ import time
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.infra.safe_read import kind_of
 
 TEMP_MARKER = ".ar3cli-tmp-"
 """Part of every temporary file name written by :func:`atomic_write`."""
@@ -87,7 +88,7 @@ def check_writable(path: Path, follow_symlinks: bool = False) -> Path:
     if mode is not None and stat.S_ISDIR(mode):
         raise UserError(f"{path}: is a directory; give a file name")
     if mode is not None and not stat.S_ISREG(mode):
-        raise UserError(f"{path}: exists and is not a regular file ({_kind(mode)}); refusing to replace it: "
+        raise UserError(f"{path}: exists and is not a regular file ({kind_of(mode)}); refusing to replace it: "
                         "give the name of a file")
     if not path.parent.is_dir():
         raise UserError(f"{path}: folder {path.parent} does not exist")
@@ -95,17 +96,6 @@ def check_writable(path: Path, follow_symlinks: bool = False) -> Path:
         # a rename would replace it anyway (it needs only a writable folder): respect the intent
         raise UserError(f"{path}: is read-only for you; make it writable first (chmod u+w) if it should change")
     return path
-
-
-def _kind(mode: int) -> str:
-    """What a file that is not a regular file is, for the refusal."""
-    if stat.S_ISFIFO(mode):
-        return "a FIFO"
-    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
-        return "a device"
-    if stat.S_ISSOCK(mode):
-        return "a socket"
-    return "not a regular file"
 
 
 def atomic_write(path: Path, data: bytes, validate=None, durable: bool = True, *, follow_symlinks: bool = False,

@@ -29,7 +29,7 @@ from typing import NamedTuple
 from ar3cli.errors import UserError
 from ar3cli.infra.safe_read import MAX_FILE_BYTES
 from ar3cli.output.report import log
-from ar3cli.urdf.packages import PackageResolver
+from ar3cli.urdf.packages import PackageResolver, shown_places
 from ar3cli.urdf.xacro_safe import ReadRoots, XacroPolicy, read_inside, safe_hooks
 
 
@@ -163,7 +163,8 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
     def find_package(name: str) -> str:
         folder, tried = resolver.find_package(name)
         if folder is None:
-            failures.append(UserError(f"{path}: $(find {name}): package not found; tried {', '.join(tried)}; "
+            failures.append(UserError(f"{path}: $(find {name}): package not found; tried "
+                                      f"{shown_places(tried, resolver.base_dir)}; "
                                       f"pass --package-path {name}=DIR"))
             raise failures[-1]
         roots.add_package(folder)
@@ -300,6 +301,8 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
         if inp is not None or filename is None:
             return original_parse(inp, filename)
         full = os.path.join(getattr(xacro, "root_dir", os.curdir), filename)
+        if roots is not None:
+            roots.check(full)  # outside: refused whether or not something is there
         if roots is not None and os.path.lexists(full):
             text = read_inside(roots, full).decode(locale.getpreferredencoding(False))  # as open() decodes
             return Builder(str(filename)).parseString(text)

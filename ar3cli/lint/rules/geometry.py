@@ -61,7 +61,7 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
-            tried = "; looked in " + ", ".join(resolution.tried) if resolution.tried else ""
+            tried = "; looked in " + resolution.places() if resolution.tried else ""
             yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{tried}",
                       geometry.element)
 
