@@ -362,6 +362,32 @@ def test_rev_path_side_with_xacro_args(repo, tmp_path):
     assert not list((tmp_path / "tmpdir").iterdir())
 
 
+def test_a_folder_named_like_rev_path_never_becomes_the_old_side(repo, tmp_path):
+    """A pull request committed a folder ``HEAD:other`` holding its own copy of the changed file:
+    ``REV:path`` was looked up on disk first, so the diff compared the new file with itself ("no
+    semantic change" while the mass went 1 -> 50 kg). A revision wins whenever REV resolves, and
+    the command says which it read; ``./REV:path`` and ``--old-rev`` spell out either reading."""
+    env = _private_tmp(tmp_path)
+    heavy = ARM.replace('<mass value="2.0"/>', '<mass value="50"/>', 1)
+    assert heavy != ARM
+    write(repo, "other/still.urdf", heavy)
+    write(repo, "HEAD:other/still.urdf", heavy)  # the planted old side
+    for args in (["--changed-since", "HEAD", "other"], ["HEAD:other/still.urdf", "other/still.urdf"],
+                 ["--old-rev", "HEAD", "other/still.urdf"]):
+        result = run_cli("diff", *args, "-f", "json", "-n", "2", cwd=repo, env=env)
+        assert result.code == 1, (args, result.stdout, result.stderr)
+        [robot] = json.loads(result.stdout)["robots"]
+        assert robot["old"] == "HEAD:other/still.urdf" and any(c["what"] == "mass" for c in robot["changes"]), args
+    noted = run_cli("diff", "HEAD:other/still.urdf", "other/still.urdf", "-n", "2", cwd=repo, env=env)
+    commit = subprocess.run(["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True, text=True).stdout
+    assert noted.stderr.splitlines() == [
+        f"ar3cli: note: OLD HEAD:other/still.urdf: the file other/still.urdf as git revision HEAD ({commit[:12]}) "
+        "holds it (not the file of that name: write ./HEAD:other/still.urdf for it)"]
+    as_file = run_cli("diff", "./HEAD:other/still.urdf", "other/still.urdf", "-n", "2", cwd=repo, env=env)
+    assert as_file.code == 0 and "the file of that name (./HEAD is no git revision here)" in as_file.stderr
+    assert not list((tmp_path / "tmpdir").iterdir())
+
+
 def test_changed_since_reports_an_added_robot_file(repo, tmp_path):
     write(repo, "other/new_robot.urdf", ARM)
     document = json.loads(run_cli("diff", "--changed-since", "HEAD", "other", "-f", "json", cwd=repo).stdout)
