@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import enum
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
@@ -51,6 +51,10 @@ EngineOption = Annotated[Engine, typer.Option(
                      "unreadable meshes, contacts at home, 1 s under gravity; needs pip install 'ar3cli[mujoco]'), "
                      "or all.")]
 NoConfigOption = Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
+IsolatedOption = Annotated[bool, typer.Option(
+    "--isolated", help="Judge the files by the command line alone: ignore \\[tool.ar3cli.lint] in pyproject.toml "
+                       "and the files' own suppression comments (ar3cli: ignore, ar3cli: ignore-file); a baseline only "
+                       "when --baseline names one. For pull requests whose author may have written those.")]
 JobsOption = Annotated[Optional[int], typer.Option(
     "--jobs", "-j", min=1, show_default=False,
     help="Processes that share the files, at most one per CPU. Default on Linux: one per 24 files or per 256 KB "
@@ -90,6 +94,30 @@ TargetOption = Annotated[Optional[list[str]], typer.Option(
     "--target", metavar="ENGINES",
     help="Engines the robot is meant for (comma-separated or repeated: pybullet, ros, mujoco, isaac, drake, "
          "gazebo): adds each one's known traps (T rules). Default: pybullet,ros.", show_default=False)]
+
+
+def linter_options(config: Any, select: list[str] | None = None, ignore: list[str] | None = None,
+                   isolated: bool = False, **settings: Any) -> Any:
+    """The linter's :class:`~ar3cli.lint.engine.LintOptions` for the command line's ``--select`` and
+    ``--ignore`` (their CODES strings) and the project's ``config`` (a
+    :class:`~ar3cli.lint.config.LintConfig`); ``settings`` are the other LintOptions fields.
+
+    What the command line selects is what runs; the configuration's select, ignore and
+    per-file-ignores only suppress findings afterwards (counted, and said in every format), its
+    severity table re-grades them. ``isolated`` (``--isolated``) also reports what the files' own
+    comments suppress. A malformed code is a UserError."""
+    from ar3cli.lint.engine import LintOptions
+    from ar3cli.lint.rules import validate_patterns
+
+    try:
+        chosen = validate_patterns(split_codes(select), "--select") if select else None
+        return LintOptions(select=chosen or ["ALL"], ignore=validate_patterns(split_codes(ignore), "--ignore"),
+                           config_select=None if chosen else config.select, config_ignore=list(config.ignore),
+                           per_file_ignores=config.per_file_ignores, severity=config.severity,
+                           config_file=str(config.path) if config.path is not None else None,
+                           in_file=not isolated, **settings)
+    except ValueError as exc:
+        raise UserError(str(exc)) from None
 
 
 def split_codes(items: list[str] | None) -> list[str]:

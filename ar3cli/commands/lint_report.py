@@ -30,7 +30,9 @@ def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: b
     findings = [finding for result in results for finding in result.findings]
     data = {"files": [result.to_dict() for result in results],
             "findings": [{**finding.to_dict(), "fixed_by": fixed_by(finding.rule)} for finding in findings],
-            "summary": summary}
+            "summary": summary,
+            "suppressed": [{**item.finding.to_dict(), "suppressed_by": item.by}
+                           for result in results for item in result.suppressed]}
     return LintReport(results, summary, data, options.rules, group=group_findings if grouped else None,
                       context=finding_context, **extra)
 
@@ -39,17 +41,17 @@ def lint_document(path: Path, source: RobotSource) -> tuple[dict, list]:
     """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
     and the findings, the file read as ``source`` says (its packages, xacro arguments, ``--xacro``
     mode and ``--xacro-env``, as the rest of the page reads it)."""
+    from ar3cli.commands.lint_options import linter_options
     from ar3cli.findings import Severity
     from ar3cli.lint.config import load_config
-    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
+    from ar3cli.lint.engine import lint_paths, summarize
 
     config = load_config()
     packages, xacro_args = source.specs()
-    options = LintOptions(select=config.select or ["ALL"], ignore=config.ignore,
-                          per_file_ignores=config.per_file_ignores, severity=config.severity,
-                          package_paths=packages, xacro_args=xacro_args)
+    options = linter_options(config, package_paths=packages, xacro_args=xacro_args)
     results = lint_paths([path], options)
-    summary = summarize(results, config.fail_on or Severity.ERROR)
+    summary = {**summarize(results, config.fail_on or Severity.ERROR), "config_file": options.config_file,
+               "isolated": False}
     summary["exit_code"] = exit_code(summary)
     made = lint_report(results, summary, options)
     return made.data, made.findings

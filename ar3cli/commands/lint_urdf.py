@@ -18,6 +18,7 @@ from ar3cli.commands.lint_options import (
     FixHintOption,
     GroupOption,
     IgnoreOption,
+    IsolatedOption,
     JobsOption,
     LintFormatOption,
     NoCacheOption,
@@ -29,8 +30,8 @@ from ar3cli.commands.lint_options import (
     TargetOption,
     WideOption,
     WriteBaselineOption,
+    linter_options,
     parse_targets,
-    split_codes,
     srdf_disabled,
 )
 from ar3cli.commands.options import (
@@ -58,6 +59,7 @@ def lint_urdf(
     sim: SimOption = False,
     engine: EngineOption = Engine.pybullet,
     no_config: NoConfigOption = False,
+    isolated: IsolatedOption = False,
     jobs: JobsOption = None,
     no_cache: NoCacheOption = False,
     fix_hint: FixHintOption = False,
@@ -93,8 +95,7 @@ def lint_urdf(
     from ar3cli.commands.lint_report import exit_code, lint_report
     from ar3cli.findings import Severity
     from ar3cli.lint.config import LintConfig, load_config
-    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
-    from ar3cli.lint.rules import validate_patterns
+    from ar3cli.lint.engine import lint_paths, summarize
     from ar3cli.urdf.loading import apply_xacro_options
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_args import parse_xacro_args
@@ -106,16 +107,14 @@ def lint_urdf(
         from ar3cli.sim.mujoco_session import import_mujoco
 
         import_mujoco()  # a missing extra: one line naming it, exit 2
-    config = LintConfig() if no_config else load_config()
+    config = LintConfig() if no_config or isolated else load_config()
     try:
-        options = LintOptions(
-            select=(validate_patterns(split_codes(select), "--select") if select else config.select) or ["ALL"],
-            ignore=[*config.ignore, *validate_patterns(split_codes(ignore), "--ignore")],
-            per_file_ignores=config.per_file_ignores, severity=config.severity, sim=sim,
-            package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg),
-            srdf_disabled=srdf_disabled(srdf, sim), engines=engines, targets=parse_targets(target))
+        package_paths, xacro_args = parse_package_paths(package_path), parse_xacro_args(xacro_arg)
     except ValueError as exc:
         raise UserError(str(exc)) from None
+    options = linter_options(config, select, ignore, isolated, sim=sim, package_paths=package_paths,
+                             xacro_args=xacro_args, srdf_disabled=srdf_disabled(srdf, sim), engines=engines,
+                             targets=parse_targets(target))
     apply_xacro_options(xacro is XacroMode.trusted, xacro_env)
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
     accepted = None
@@ -142,8 +141,9 @@ def lint_urdf(
         from ar3cli.lint.baseline import apply_baseline
 
         results, baselined, unused = apply_baseline(results, accepted)
-        held = {"baselined": baselined, "baseline_unused": unused}
-    summary = {**summarize(results, threshold), **(held or {})}
+        held = {"baselined": baselined, "baseline_unused": unused, "baseline": str(baseline)}
+    summary = {**summarize(results, threshold), **(held or {}), "config_file": options.config_file,
+               "isolated": isolated}
     summary["exit_code"] = exit_code(summary, exit_zero)
     fixes = None
     if fix_hint:

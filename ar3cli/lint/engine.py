@@ -10,6 +10,7 @@ open a :class:`~ar3cli.sim.session.Session` lazily through :attr:`Context.sessio
 
 from __future__ import annotations
 
+import dataclasses
 import fnmatch
 import functools
 import os
@@ -54,11 +55,23 @@ class LintOptions:
     """Simulators ``--sim`` runs (``--engine``): P rules need ``pybullet``, M rules ``mujoco`` (or their code named)."""
     targets: tuple[str, ...] = ("pybullet", "ros")
     """Engines the robot is meant for (``--target``): their T rules run."""
+    config_select: list[str] | None = None
+    """``[tool.ar3cli.lint] select`` when the command line gave no ``--select``: the findings of
+    other rules are suppressed by the configuration (counted and said, never silently dropped)."""
+    config_ignore: list[str] = field(default_factory=list)
+    """``[tool.ar3cli.lint] ignore``: the findings of these rules are suppressed by the configuration."""
+    config_file: str | None = None
+    """The pyproject.toml the configuration came from, as the summary names it."""
+    in_file: bool = True
+    """Honour the files' own suppression comments (``ar3cli: ignore``, ``ar3cli: ignore-file``);
+    ``--isolated`` turns it off."""
 
     def rules(self) -> list[Rule]:
         """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
-        when ``select`` names their code; target rules only for the ``targets`` (or when named)."""
-        named = {code.upper() for code in self.select}
+        when ``select`` (or the configuration's) names their code; target rules only for the
+        ``targets`` (or when named). The configuration's select and ignore do not narrow this: their
+        rules run and their findings are suppressed by :func:`settle`, so the run can say so."""
+        named = {code.upper() for code in (*self.select, *(self.config_select or []))}
         return [r for r in RULES if matches(r.code, self.select) and not matches(r.code, self.ignore)
                 and (self.sim or not r.needs_sim) and (not r.opt_in or r.code in named)
                 and (not r.needs_sim or ENGINE_OF.get(r.code[0]) in self.engines or r.code in named)
@@ -76,9 +89,26 @@ class LintResult:
     error: str | None = None
     cached: bool = False
     """Answered from the result cache (said in the text summary; the JSON is the same either way)."""
+    suppressed: list[Suppressed] = field(default_factory=list)
+    """Findings not reported, and by what: the file's comments, the configuration, the baseline."""
+    lowered: int = 0
+    """Findings the configuration's ``severity`` table made less severe than their rule's."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
+
+
+SUPPRESSED_BY = ("config", "comment", "baseline")
+"""What may suppress a finding: ``[tool.ar3cli.lint]`` (select, ignore, per-file-ignores), a comment
+in the file (``ar3cli: ignore``, ``ar3cli: ignore-file``), or ``--baseline``."""
+
+
+@dataclass(frozen=True)
+class Suppressed:
+    """A finding that is not reported, and what suppressed it (one of :data:`SUPPRESSED_BY`)."""
+
+    finding: Finding
+    by: str
 
 
 def display_path(path: Path) -> str:
@@ -149,7 +179,7 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
     if workers <= 1:
-        return [lint_file(path, rules, options, cache) for path in files]
+        return [settle(lint_file(path, rules, options, cache), options) for path in files]
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
     order = balanced_order(sizes, workers)
@@ -157,8 +187,43 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     results: list[LintResult] = [None] * len(files)  # type: ignore[list-item]
     for index, (result, learned) in zip(order, outcomes):
         merge_learned(learned)
-        results[index] = result
+        results[index] = settle(result, options)
     return results
+
+
+def settle(result: LintResult, options: LintOptions) -> LintResult:
+    """``result`` (as :func:`lint_file` gives it) with the run's settings applied: without
+    ``in_file``, the findings the file's own comments suppressed are reported again; the findings
+    the configuration deselects (its ``select``, ``ignore``, ``per-file-ignores``) move to the
+    suppressed ones, by ``config``; its ``severity`` table is applied (``lowered`` counts the
+    findings it made less severe). A file that could not be loaded reports why whatever the
+    configuration selected: only its ``ignore`` suppresses that."""
+    findings, suppressed = list(result.findings), []
+    for item in result.suppressed:
+        if item.by == "comment" and not options.in_file:
+            findings.append(item.finding)
+        else:
+            suppressed.append(item)
+    if len(findings) != len(result.findings):
+        findings.sort(key=lambda f: (f.path != result.path, f.path, f.line, f.column, f.rule))
+    kept, lowered = [], 0
+    for finding in findings:
+        if _config_suppresses(finding, result, options):
+            suppressed.append(Suppressed(finding, "config"))
+            continue
+        changed = _override(finding, options)
+        lowered += changed.severity < finding.severity
+        kept.append(changed)
+    return dataclasses.replace(result, findings=kept, suppressed=suppressed, lowered=result.lowered + lowered)
+
+
+def _config_suppresses(finding: Finding, result: LintResult, options: LintOptions) -> bool:
+    code = finding.rule
+    if matches(code, options.config_ignore) or _file_ignored(finding.path, code, options):
+        return True
+    if finding.path != result.path and _file_ignored(result.path, code, options):  # an included file's finding
+        return True
+    return options.config_select is not None and result.loaded and not matches(code, options.config_select)
 
 
 def _workers(jobs: int | None, sizes: list[int], sim: bool) -> int:
@@ -211,8 +276,7 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
         return None
     from ar3cli.lint.result_cache import ResultCache
 
-    return ResultCache.for_settings(rules=[rule.code for rule in rules], per_file_ignores=options.per_file_ignores,
-                                    severity=options.severity, package_paths=options.package_paths,
+    return ResultCache.for_settings(rules=[rule.code for rule in rules], package_paths=options.package_paths,
                                     xacro_args=options.xacro_args)
 
 
@@ -229,7 +293,8 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     if cache is not None and not is_xacro(path):
         remembered = cache.get(path, shown)
         if remembered is not None:
-            return LintResult(shown, True, remembered, cached=True)
+            found, by_comment = remembered
+            return LintResult(shown, True, found, cached=True, suppressed=[Suppressed(f, "comment") for f in by_comment])
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
@@ -242,14 +307,15 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
         return LintResult(shown, False, [], f"{shown}: {internal_error('while loading it', exc)}")
     else:
         result = lint_model(model, shown, rules, options)
-        if cache is not None and not model.is_xacro:
-            cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
+        if cache is not None and not model.is_xacro and result.error is None:
+            cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed,
+                      [item.finding for item in result.suppressed if item.by == "comment"])
         return result
     # A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
-    # always reports syntax errors); only an explicit ignore hides it.
-    if matches(finding.rule, options.ignore) or _file_ignored(shown, finding.rule, options):
+    # always reports syntax errors); only an explicit ignore hides it (the configuration's: settle).
+    if matches(finding.rule, options.ignore):
         return LintResult(shown, False, [])
-    return LintResult(shown, False, [_override(finding, options)])
+    return LintResult(shown, False, [finding])
 
 
 def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
@@ -259,7 +325,7 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
     """
     static, simulated, in_mujoco = _partition(rules)
-    findings, failures = _run_rules(model, shown, static, options)
+    findings, suppressed, failures = _run_rules(model, shown, static, options)
     error = None
     if simulated or in_mujoco:
         from ar3cli.infra.isolation import CrashError
@@ -270,16 +336,18 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
             if not selected:
                 continue
             try:
-                found, failed = run(lambda selected=selected: _run_rules(model, shown, selected, options), model)
+                found, held, failed = run(lambda selected=selected: _run_rules(model, shown, selected, options),
+                                          model)
             except CrashError as exc:
                 error = exc.message
             else:
                 findings += found
+                suppressed += held
                 failures += failed
     if failures and error is None:
         error = f"{shown}: {failures[0]}" + (f" (and {len(failures) - 1} more rules)" if len(failures) > 1 else "")
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
-    return LintResult(shown, True, findings, error)
+    return LintResult(shown, True, findings, error, suppressed=suppressed)
 
 
 def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
@@ -298,9 +366,11 @@ def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
 _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
 
 
-def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> tuple[list[Finding], list[str]]:
-    """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted), and one line per rule
-    that failed on this file.
+def _run_rules(model, shown: str, rules: list[Rule],
+               options: LintOptions) -> tuple[list[Finding], list[Suppressed], list[str]]:
+    """The located findings of ``rules`` on ``model`` (unsorted), those the file's own comments
+    suppress, and one line per rule that failed on this file. The configuration is applied later,
+    by :func:`settle` (so the result cache holds what the file alone decides).
 
     A rule that raises (a value the file holds overflows a computation it did not expect, say) is a
     bug in that rule: its findings so far are kept, the other rules still run, and the file's error
@@ -308,8 +378,9 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> tu
     """
     context = Context(model, options.srdf_disabled)
     locator = Locator(model, shown)
-    file_ignores = _file_level_ignores(model.source_bytes)
+    file_ignores = _file_level_ignores(model)
     findings: list[Finding] = []
+    suppressed: list[Suppressed] = []
     failures: list[str] = []
     try:
         for rule in rules:
@@ -317,22 +388,20 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> tu
                 continue
             try:
                 for hit in rule.check(context):
-                    if matches(rule.code, file_ignores) or _file_ignored(shown, rule.code, options):
-                        continue
-                    if hit.element is not None and suppressed_inline(hit.element, rule.code):
-                        continue
                     path, line, column = locator.locate(hit)
-                    if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
-                        continue
-                    findings.append(_override(Finding(rule.code, rule.severity, hit.message, path, line, column,
-                                                      hit.hint or rule.fix), options))
+                    finding = Finding(rule.code, rule.severity, hit.message, path, line, column, hit.hint or rule.fix)
+                    if matches(rule.code, file_ignores) or (hit.element is not None
+                                                            and suppressed_inline(hit.element, rule.code)):
+                        suppressed.append(Suppressed(finding, "comment"))
+                    else:
+                        findings.append(finding)
             except (UserError, MemoryError):
                 raise
             except Exception as exc:  # noqa: BLE001 - a rule's bug: this file's error line, the batch goes on
                 failures.append(internal_error(f"in rule {rule.code}", exc) + "; the other rules ran")
     finally:
         context.close()
-    return findings, failures
+    return findings, suppressed, failures
 
 
 def internal_error(where: str, exc: BaseException) -> str:
@@ -455,11 +524,33 @@ def _file_ignored(shown: str, code: str, options: LintOptions) -> bool:
     return False
 
 
-def _file_level_ignores(source: bytes) -> list[str]:
+def _file_level_ignores(model) -> list[str]:
+    """The codes of the ``<!-- ar3cli: ignore-file[...] -->`` comments of the file: only in an XML
+    comment, as documented (the same words in a name or a text were a way to silence a file), and
+    in the file as written (a xacro's source, not its expansion)."""
+    if not _FILE_LEVEL.search(model.source_bytes):
+        return []
     codes: list[str] = []
-    for match in _FILE_LEVEL.finditer(source):
-        codes += _codes(match.group(1).decode("ascii", "replace") if match.group(1) is not None else None)
+    for comment in _comments(model):
+        for match in _FILE_LEVEL.finditer((comment.text or "").encode("utf-8", "surrogateescape")):
+            codes += _codes(match.group(1).decode("ascii", "replace") if match.group(1) is not None else None)
     return codes
+
+
+def _comments(model) -> list[Any]:
+    """Every comment of the file as written, those before and after its root element included."""
+    from lxml import etree
+
+    from ar3cli.urdf import xmlsource
+
+    root = model.root
+    if model.is_xacro:
+        try:
+            root, _ = xmlsource.parse(xmlsource.normalize(model.source_bytes)[0], model.path)
+        except UserError:
+            return []
+    return [*root.itersiblings(etree.Comment, preceding=True), *root.iter(etree.Comment),
+            *root.itersiblings(etree.Comment)]
 
 
 def _codes(text: str | None) -> list[str]:
@@ -590,18 +681,23 @@ def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
     ``error``/``warning``/``info`` count findings; ``files_with_errors`` the files with at least one
     error finding (so it is 0 exactly when ``error`` is); ``files_not_checked`` the files whose check
     was cut short (pybullet crashed: exit 2). ``failed`` is the verdict of the summary line: a
-    finding at or above ``fail_on`` (``findings_failing``), or a file not checked.
+    finding at or above ``fail_on`` (``findings_failing``), or a file not checked. ``suppressed``
+    counts the findings not reported by what suppressed them (:data:`SUPPRESSED_BY`), and
+    ``severity_lowered`` those the configuration made less severe.
     """
     findings = [f for r in results for f in r.findings]
     counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}
     failing = sum(f.severity >= fail_on for f in findings)
     not_checked = sum(r.error is not None for r in results)
+    held = Counter(item.by for r in results for item in r.suppressed)
     return {"files": len(results), "files_with_findings": sum(bool(r.findings) for r in results),
             "files_with_errors": sum(any(f.severity is Severity.ERROR for f in r.findings) for r in results),
             "files_not_checked": not_checked,
             "files_clean": sum(not r.findings and r.error is None for r in results),
             "findings": len(findings), **counts, "fail_on": fail_on.value, "findings_failing": failing,
-            "failed": bool(failing or not_checked)}
+            "failed": bool(failing or not_checked),
+            "suppressed": {by: held[by] for by in SUPPRESSED_BY},
+            "severity_lowered": sum(r.lowered for r in results)}
 
 
 def find_rule(code: str) -> Rule:

@@ -26,8 +26,15 @@ def artifact_uri(path: str) -> str:
     return Path(relative).as_posix() if not relative.startswith("..") else candidate.as_uri()
 
 
-def sarif_document(findings: list[Finding], rules) -> dict[str, Any]:
-    """One SARIF log with one run: the tool's rule metadata and one result per finding."""
+SUPPRESSION_KINDS = {"comment": "inSource", "config": "external", "baseline": "external"}
+"""SARIF's ``suppression.kind`` of each thing that suppresses a finding (a comment in the file is
+in source; the configuration and a baseline are outside it)."""
+
+
+def sarif_document(findings: list[Finding], rules, suppressed: list[tuple[Finding, str, str]] = ()) -> dict[str, Any]:
+    """One SARIF log with one run: the tool's rule metadata and one result per finding; each
+    ``suppressed`` (finding, by, justification) is a result too, with its ``suppressions``, so code
+    scanning shows it as dismissed instead of never seeing it."""
     index = {rule.code: i for i, rule in enumerate(rules)}
     driver = {
         "name": "ar3cli",
@@ -45,7 +52,7 @@ def sarif_document(findings: list[Finding], rules) -> dict[str, Any]:
         } for rule in rules],
     }
     results = []
-    for finding in findings:
+    for finding, by, justification in [*((finding, "", "") for finding in findings), *suppressed]:
         location: dict[str, Any] = {"artifactLocation": {"uri": artifact_uri(finding.path)}}
         if finding.line:
             location["region"] = {"startLine": finding.line, "startColumn": max(finding.column, 1)}
@@ -57,5 +64,7 @@ def sarif_document(findings: list[Finding], rules) -> dict[str, Any]:
         }
         if finding.rule in index:
             result["ruleIndex"] = index[finding.rule]
+        if by:
+            result["suppressions"] = [{"kind": SUPPRESSION_KINDS[by], "justification": justification}]
         results.append(result)
     return {"$schema": SCHEMA, "version": "2.1.0", "runs": [{"tool": {"driver": driver}, "results": results}]}
