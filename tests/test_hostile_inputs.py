@@ -184,3 +184,62 @@ def test_places_searched_outside_the_tree_are_counted_not_named(cli, tmp_path):
     assert str(tmp_path) not in message and "/work/" not in message, message
     assert message.endswith("looked in ancestors of the robot's folder named nopkg or with package.xml "
                             f"<name>nopkg</name>, nopkg/m.stl, {len(repo.parents)} places outside the robot's folder")
+
+
+# ---- no secret on the page -----------------------------------------------------------------------
+
+SECRET = "aws_secret_access_key = hunter2-do-not-show"
+
+
+def test_a_symlinked_robot_file_leading_out_of_its_folder_is_never_shown(cli, tmp_path):
+    """``ln -s ~/.aws/credentials robot.urdf; lint-urdf --format html robot.urdf`` showed the secret
+    (F002's cited lines were read back from the file); so did ``/proc/self/environ``. A file named on
+    the command line is still linted as asked; its lines are shown only when it lies in its own
+    folder, and only as the bytes that were parsed."""
+    outside = tmp_path / "home" / ".aws"
+    outside.mkdir(parents=True)
+    (outside / "credentials").write_text(f"[default]\n{SECRET}\n")
+    repo = tmp_path / "repo"
+    repo.mkdir()
+    (repo / "robot.urdf").symlink_to(outside / "credentials")
+    (repo / "environ.urdf").symlink_to("/proc/self/environ")
+    (repo / "own.urdf").write_text(GOOD.replace("</robot>", "<bad></robot>"))  # F002 on a file of the tree
+    result = cli("lint-urdf", "--format", "html", "robot.urdf", "environ.urdf", "own.urdf", cwd=repo,
+                 env={"AR3CLI_TEST_SECRET": SECRET})
+    assert result.code == 1, result.stderr
+    assert "hunter2" not in result.stdout and "AR3CLI_TEST_SECRET" not in result.stdout
+    assert result.stdout.count("F002") >= 3  # each is still a finding
+    assert "&lt;bad&gt;" in result.stdout  # the tree's own file keeps its cited lines
+
+
+def test_cited_lines_are_only_the_bytes_that_were_parsed(tmp_path):
+    from ar3cli.commands.finding_context import finding_context
+    from ar3cli.findings import Finding, Severity
+
+    path = tmp_path / "r.urdf"
+    path.write_text("<robot>\n<link/>\n</robot>\n")
+    finding = Finding("S001", Severity.ERROR, "m", str(path), 2, 1, "")
+    import hashlib
+
+    digest = hashlib.sha256(path.read_bytes()).hexdigest()
+    assert finding_context([finding], {str(path): digest})["sources"][str(path)][2] == "<link/>"
+    assert finding_context([finding], {})["sources"] == {}  # not a file the linter may show
+    path.write_text(f"<robot>\n{SECRET}\n</robot>\n")  # replaced after it was linted
+    assert finding_context([finding], {str(path): digest})["sources"] == {}
+
+
+def test_a_folder_search_leaves_out_links_leading_out_of_it(cli, tmp_path):
+    outside = tmp_path / "outside"
+    outside.mkdir()
+    (outside / "secret.urdf").write_text(GOOD)
+    robots = tmp_path / "repo" / "robots"
+    robots.mkdir(parents=True)
+    (robots / "good.urdf").write_text(GOOD)
+    (robots / "inside.urdf").symlink_to("good.urdf")
+    (robots / "out.urdf").symlink_to(outside / "secret.urdf")
+    result = cli("lint-urdf", "-f", "json", "robots", cwd=tmp_path / "repo")
+    assert [entry["path"] for entry in json.loads(result.stdout)["files"]] == ["robots/good.urdf", "robots/inside.urdf"]
+    assert result.stderr.splitlines() == ["ar3cli: note: skipped 1 symbolic link to a file outside the folder "
+                                          "searched (robots/out.urdf); name a file as PATH to lint it"]
+    named = cli("lint-urdf", "-f", "json", "robots/out.urdf", cwd=tmp_path / "repo")
+    assert [entry["path"] for entry in json.loads(named.stdout)["files"]] == ["robots/out.urdf"]

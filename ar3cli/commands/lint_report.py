@@ -23,6 +23,8 @@ def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: b
     """The report of ``results`` (``lint.engine.lint_paths``) and ``summary`` (``summarize``) for
     ``options`` (``LintOptions``); ``grouped`` folds alike findings into one text row; ``extra``
     sets the remaining :class:`LintReport` fields (note, changed, fix_commands, exit_zero, wide)."""
+    import functools
+
     from ar3cli.commands.finding_context import finding_context
     from ar3cli.lint.engine import group_findings
     from ar3cli.lint.fix_hints import fixed_by
@@ -33,14 +35,16 @@ def lint_report(results: list, summary: dict[str, Any], options: Any, grouped: b
             "summary": summary,
             "suppressed": [{**item.finding.to_dict(), "suppressed_by": item.by}
                            for result in results for item in result.suppressed]}
+    digests = {path: digest for result in results for path, digest in result.sources.items()}
     return LintReport(results, summary, data, options.rules, group=group_findings if grouped else None,
-                      context=finding_context, **extra)
+                      context=functools.partial(finding_context, digests=digests), **extra)
 
 
-def lint_document(path: Path, source: RobotSource) -> tuple[dict, list]:
+def lint_document(path: Path, source: RobotSource) -> tuple[dict, Any]:
     """``lint-urdf --format json PATH``'s document (the project's configuration applies, as there)
-    and the findings, the file read as ``source`` says (its packages, xacro arguments, ``--xacro``
-    mode and ``--xacro-env``, as the rest of the page reads it)."""
+    and its :class:`LintReport` (findings, and the context a page shows with them), the file read as
+    ``source`` says (its packages, xacro arguments, ``--xacro`` mode and ``--xacro-env``, as the
+    rest of the page reads it)."""
     from ar3cli.commands.lint_options import linter_options
     from ar3cli.findings import Severity
     from ar3cli.lint.config import load_config
@@ -48,10 +52,10 @@ def lint_document(path: Path, source: RobotSource) -> tuple[dict, list]:
 
     config = load_config()
     packages, xacro_args = source.specs()
-    options = linter_options(config, package_paths=packages, xacro_args=xacro_args)
+    options = linter_options(config, package_paths=packages, xacro_args=xacro_args, sources=True)
     results = lint_paths([path], options)
     summary = {**summarize(results, config.fail_on or Severity.ERROR), "config_file": options.config_file,
                "isolated": False}
     summary["exit_code"] = exit_code(summary)
     made = lint_report(results, summary, options)
-    return made.data, made.findings
+    return made.data, made

@@ -114,7 +114,7 @@ def lint_urdf(
         raise UserError(str(exc)) from None
     options = linter_options(config, select, ignore, isolated, sim=sim, package_paths=package_paths,
                              xacro_args=xacro_args, srdf_disabled=srdf_disabled(srdf, sim), engines=engines,
-                             targets=parse_targets(target))
+                             targets=parse_targets(target), sources=str(getattr(format, "value", format)) == "html")
     apply_xacro_options(xacro is XacroMode.trusted, xacro_env)
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
     accepted = None
@@ -130,8 +130,13 @@ def lint_urdf(
         results = lint_paths(selection.files, options, use_cache=not no_cache, jobs=jobs) if selection.files else []
         no_files = not selection.candidates
     else:
-        results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs)
+        skipped: list[str] = []
+        results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs, skipped=skipped)
         no_files = not results
+        if skipped:
+            from ar3cli.output.report import log
+
+            log(skipped_links_note(skipped))
     if no_files:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     if write_baseline is not None:
@@ -167,6 +172,13 @@ def _write_baseline(path: Path, results, fmt, follow_symlinks: bool = False) -> 
     data = {"baseline": str(path), "findings": count, "files_with_findings": files, "files": len(results)}
     finish(Report(data=data, lines=[line], errors=[r.error for r in results if r.error]),
            "json" if fmt == "json" else "text")
+
+
+def skipped_links_note(skipped: list[str]) -> str:
+    """The note for the symbolic links a folder's search left out (they lead out of the folder)."""
+    shown = ", ".join(skipped[:3]) + (f" and {len(skipped) - 3} more" if len(skipped) > 3 else "")
+    return (f"ar3cli: note: skipped {len(skipped)} symbolic link{'s' if len(skipped) != 1 else ''} to a file outside "
+            f"the folder searched ({shown}); name a file as PATH to lint it")
 
 
 def explain_rule(code: str, fmt) -> None:

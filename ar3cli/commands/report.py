@@ -59,7 +59,6 @@ def report(
     JSON documents of info --torques, lint-urdf, sample-collisions and fk-verify for the same
     --samples and --seed.
     """
-    from ar3cli.commands.finding_context import finding_context
     from ar3cli.commands.lint_report import lint_document
     from ar3cli.infra.atomic import atomic_write, check_writable
     from ar3cli.output.html import robot_page
@@ -69,7 +68,7 @@ def report(
                                          "described": f"{samples} samples, seed {seed}"}, "skipped": {},
                             "cross_check": None}
     lines: dict[str, list[str]] = {}
-    data["lint"], findings = lint_document(path, source)
+    data["lint"], linted = lint_document(path, source)
     model = source.load(path)
     data["info"], lines["info"], lines["torques"] = _info(model, samples, seed, data["skipped"])
     pictures = _pictures(model, lines.setdefault("pictures", []))
@@ -79,7 +78,7 @@ def report(
     data["fk"], lines["fk"] = _attempt(lambda: _fk(model, path, samples, seed), "fk", data["skipped"])
     data["cross_check"], lines["cross_check"] = _attempt(lambda: _cross_check(model, path, samples, seed),
                                                          "cross_check", data["skipped"])
-    context = {"lines": lines, **finding_context(findings)}
+    context = {"lines": lines, **linted.context(linted.findings)}
     document = robot_page(data, context, pictures).encode("utf-8")
     atomic_write(output, document)
     summary = data["lint"]["summary"]

@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import fnmatch
 import functools
+import hashlib
 import os
 import re
 from collections import Counter
@@ -65,6 +66,9 @@ class LintOptions:
     in_file: bool = True
     """Honour the files' own suppression comments (``ar3cli: ignore``, ``ar3cli: ignore-file``);
     ``--isolated`` turns it off."""
+    sources: bool = False
+    """Record which files' lines a page may show, with the digest of the bytes parsed
+    (:attr:`LintResult.sources`): for ``--format html`` and ``report``."""
 
     def rules(self) -> list[Rule]:
         """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
@@ -93,6 +97,9 @@ class LintResult:
     """Findings not reported, and by what: the file's comments, the configuration, the baseline."""
     lowered: int = 0
     """Findings the configuration's ``severity`` table made less severe than their rule's."""
+    sources: dict[str, str] = field(default_factory=dict)
+    """With :attr:`LintOptions.sources`: display path -> SHA-256 of the bytes ar3cli parsed, for each
+    file whose lines may be shown with a finding (:func:`shown_sources`)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
@@ -122,9 +129,12 @@ def display_path(path: Path) -> str:
     return str(path) if relative.startswith("..") else Path(relative).as_posix()
 
 
-def collect_files(paths: Iterable[Path]) -> list[Path]:
+def collect_files(paths: Iterable[Path], skipped: list[str] | None = None) -> list[Path]:
     """Files to lint: given files as they are, folders searched for ``*.urdf`` / ``*.xacro`` (sorted).
 
+    A folder's search leaves out a symbolic link whose target lies outside that folder
+    (``robot.urdf -> ~/.aws/credentials`` committed in a pull request): its display path goes to
+    ``skipped`` when given. A file named on the command line is linted as asked, link or not.
     A path that does not exist is a usage error (exit 2): it is a typo, not a finding.
     """
     found: list[Path] = []
@@ -137,7 +147,14 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
         if is_dir:
             for folder, dirs, files in os.walk(path):
                 dirs[:] = sorted(d for d in dirs if d not in _SKIP_DIRS)
-                found += [Path(folder) / name for name in sorted(files) if name.lower().endswith(ROBOT_SUFFIXES)]
+                for name in sorted(files):
+                    if not name.lower().endswith(ROBOT_SUFFIXES):
+                        continue
+                    full = os.path.join(folder, name)  # os.walk enters no linked folder: only the file may lead out
+                    if not os.path.islink(full) or inside_tree(full, path):
+                        found.append(Path(folder) / name)
+                    elif skipped is not None:
+                        skipped.append(display_path(Path(folder) / name))
         elif path.exists() or path.is_symlink():
             found.append(path)
         else:
@@ -147,6 +164,13 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
         folder, name = os.path.split(path)
         unique.setdefault(os.path.join(os.path.realpath(folder or "."), name), path)
     return list(unique.values())
+
+
+def inside_tree(file: str | os.PathLike[str], tree: str | os.PathLike[str]) -> bool:
+    """True when ``file``, symbolic links resolved, lies in the folder ``tree`` (links resolved too)
+    or below it: what ar3cli may show of a robot file (and what a folder's search takes)."""
+    root = os.path.realpath(tree)
+    return os.path.realpath(file).startswith(root.rstrip(os.sep) + os.sep)
 
 
 FILES_PER_WORKER = 24
@@ -164,18 +188,19 @@ docs/commands/lint-urdf.md."""
 
 
 def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = True,
-               jobs: int | None = None) -> list[LintResult]:
+               jobs: int | None = None, skipped: list[str] | None = None) -> list[LintResult]:
     """Lint every file under ``paths``; one :class:`LintResult` per file, in order.
 
     With ``use_cache``, unchanged files reuse the findings of an earlier run (:mod:`ar3cli.lint.result_cache`).
     ``jobs`` processes share the files (None: one per CPU for large batches, see
-    :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it.
+    :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it. ``skipped``
+    receives the links a folder's search left out (:func:`collect_files`).
     """
     from ar3cli.infra.process_pool import map_in_processes
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
-    files = collect_files(paths)
+    files = collect_files(paths, skipped)
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
     if workers <= 1:
@@ -293,10 +318,17 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     if cache is not None and not is_xacro(path):
         remembered = cache.get(path, shown)
         if remembered is not None:
-            found, by_comment = remembered
-            return LintResult(shown, True, found, cached=True, suppressed=[Suppressed(f, "comment") for f in by_comment])
+            found, by_comment, digest = remembered
+            sources = {shown: digest} if options.sources and inside_tree(path, os.path.dirname(path) or ".") else {}
+            return LintResult(shown, True, found, cached=True, suppressed=[Suppressed(f, "comment") for f in by_comment],
+                              sources=sources)
+    data = None
     try:
-        model = load_model(path, options.package_paths, options.xacro_args)
+        if options.sources:  # read here, so that what a page may show is exactly what was parsed
+            from ar3cli.infra.safe_read import read_bytes
+
+            data = read_bytes(path)
+        model = load_model(path, options.package_paths, options.xacro_args, source=data)
     except UserError as exc:
         finding = load_failure(path, shown, exc.message)
     except RecursionError:
@@ -315,7 +347,8 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     # always reports syntax errors); only an explicit ignore hides it (the configuration's: settle).
     if matches(finding.rule, options.ignore):
         return LintResult(shown, False, [])
-    return LintResult(shown, False, [finding])
+    own = data is not None and inside_tree(path, os.path.dirname(path) or ".")
+    return LintResult(shown, False, [finding], sources={shown: hashlib.sha256(data).hexdigest()} if own else {})
 
 
 def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
@@ -347,7 +380,27 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     if failures and error is None:
         error = f"{shown}: {failures[0]}" + (f" (and {len(failures) - 1} more rules)" if len(failures) > 1 else "")
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
-    return LintResult(shown, True, findings, error, suppressed=suppressed)
+    return LintResult(shown, True, findings, error, suppressed=suppressed,
+                      sources=shown_sources(model, shown) if options.sources else {})
+
+
+def shown_sources(model, shown: str) -> dict[str, str]:
+    """The files whose lines a page may show with a finding, by display path, each with the SHA-256
+    of the bytes ar3cli parsed: the linted file, unless it is a symbolic link leading out of its own
+    folder (``robot.urdf -> ~/.aws/credentials``: linted as asked, never shown), and for a xacro,
+    each file xacro parsed (read only inside the robot's folder and packages in safe mode). The
+    page re-reads a file and shows it only when its bytes still have that digest."""
+    own = inside_tree(model.path, os.path.dirname(model.path) or ".")
+    sources = {shown: hashlib.sha256(model.source_bytes).hexdigest()} if own else {}
+    if model.is_xacro:
+        from ar3cli.urdf.xacro_expand import parsed_digests
+
+        locator = Locator(model, shown)
+        for name, digest in parsed_digests(model.xml_bytes).items():
+            path = locator.shown_file(name)
+            if path != shown:
+                sources.setdefault(path, digest)
+    return sources
 
 
 def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
@@ -458,7 +511,7 @@ class Locator:
             while node is not None:
                 origin = origins.get(node)
                 if origin is not None:
-                    return self._file(origin.file), origin.line, origin.column
+                    return self.shown_file(origin.file), origin.line, origin.column
                 node = node.getparent()
         return (self.shown, *self._xacro_position(element))
 
@@ -473,7 +526,7 @@ class Locator:
             self._origins = dict(zip(elements, found)) if len(found) == len(elements) else {}
         return self._origins
 
-    def _file(self, file: str) -> str:
+    def shown_file(self, file: str) -> str:
         """The display path of a file xacro read: the linted file as shown, an included one
         relative to the current directory (``a/../b`` folded when it is the same file)."""
         if file not in self._files:

@@ -95,9 +95,9 @@ class ResultCache:
             digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
         return digest.hexdigest()
 
-    def get(self, path: Path, shown: str) -> tuple[list[Finding], list[Finding]] | None:
-        """The findings remembered for this file and those its own comments suppress, or None when
-        it must be checked."""
+    def get(self, path: Path, shown: str) -> tuple[list[Finding], list[Finding], str] | None:
+        """The findings remembered for this file, those its own comments suppress and the SHA-256
+        of its bytes, or None when it must be checked."""
         entry = _STORE.lookup(self._key(path, shown), near=path)
         content = _read(path) if entry is not MISSING else None  # a file never seen is not read twice
         if content is None:
@@ -108,7 +108,7 @@ class ResultCache:
             if any(_as_stored(path_state(dependency)) != state for dependency, state in entry["depends"].items()):
                 return None
             return ([_finding(shown, *fields) for fields in entry["findings"]],
-                    [_finding(shown, *fields) for fields in entry["suppressed"]])
+                    [_finding(shown, *fields) for fields in entry["suppressed"]], entry["content"])
         except (KeyError, TypeError, ValueError, AttributeError):  # none, or damaged: check the file
             return None
 

@@ -46,7 +46,7 @@ ORIGIN_ATTRIBUTE = "ar3cli-origin"
 """The attribute that carries an element's origin through xacro (taken off before the output)."""
 _KEEP_ORIGINS = 4
 """Expansions whose origins are kept: a file is linted right after it is expanded."""
-_origins: dict[bytes, tuple[list[Origin | None], list[str]]] = {}
+_origins: dict[bytes, tuple[list[Origin | None], list[str], dict[str, str]]] = {}
 
 
 def origins(xml_bytes: bytes) -> list[Origin | None] | None:
@@ -78,12 +78,14 @@ MEMORY_BYTES = 1024 * 1024 * 1024
 
 
 class _Expansion(NamedTuple):
-    """What the child sends back: the URDF, its elements' origins, the files xacro read, xacro's chatter."""
+    """What the child sends back: the URDF, its elements' origins, the files xacro read, xacro's
+    chatter, and the SHA-256 of the bytes of each xacro file it parsed."""
 
     data: bytes
     found: list[Origin | None]
     included: list[str]
     notes: list[str]
+    digests: dict[str, str]
 
 
 def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes:
@@ -117,7 +119,7 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver) -> bytes
         log(f"ar3cli: note: {path}: xacro says: {line}")
     while len(_origins) >= _KEEP_ORIGINS:
         del _origins[next(iter(_origins))]
-    _origins[result.data] = (result.found, result.included)
+    _origins[result.data] = (result.found, result.included, result.digests)
     return result.data
 
 
@@ -125,6 +127,14 @@ def included_files(xml_bytes: bytes) -> list[str]:
     """The files xacro read (includes, YAML) for an expansion :func:`expand` returned, as xacro named them."""
     kept = _origins.get(xml_bytes)
     return list(kept[1]) if kept is not None else []
+
+
+def parsed_digests(xml_bytes: bytes) -> dict[str, str]:
+    """For an expansion :func:`expand` returned: each xacro file it parsed (as xacro named it, as
+    :class:`Origin` names it) -> the SHA-256 of the bytes parsed. What may be shown of those files
+    is exactly these bytes (a page's cited lines are checked against them)."""
+    kept = _origins.get(xml_bytes)
+    return dict(kept[2]) if kept is not None else {}
 
 
 def _limit_this_process() -> None:
@@ -172,9 +182,10 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
 
     table: list[Origin] = []
     kept: dict = {}
+    digests: dict[str, str] = {}
     original_find, original_parse = substitution_args._eval_find, xacro.parse
     substitution_args._eval_find = find_package
-    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots)
+    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots, digests)
     chatter = io.StringIO()
     included_before = len(xacro.all_includes)
     try:
@@ -203,7 +214,7 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
                         f"{MAX_FILE_BYTES >> 20} MB limit for robot descriptions")
     notes = [line.strip() for line in chatter.getvalue().splitlines()
              if line.strip() and not line.startswith("when processing file:")]
-    return _Expansion(data, found, [str(name) for name in xacro.all_includes[included_before:]], notes)
+    return _Expansion(data, found, [str(name) for name in xacro.all_includes[included_before:]], notes, digests)
 
 
 def _located(exc: UserError, path: Path) -> UserError:
@@ -249,7 +260,8 @@ def _arguments_hint(path: Path, given: dict[str, str]) -> str:
     return f"; the file takes xacro arguments ({shown}): pass the ones it needs with --xacro-arg NAME:=VALUE"
 
 
-def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None):
+def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None,
+                        digests: dict[str, str]):
     """xacro's ``parse(inp, filename)``, noting the origin of each element read from a file.
 
     The file is read as xacro reads it (text, default encoding) and parsed by the builder
@@ -260,7 +272,9 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
     xacro to evaluate: 3 ms less on the AR3). xacro's own elements are left alone (xacro checks
     their attributes); inside ``xacro:if``/``xacro:unless`` nodes are moved, never copied.
     With ``roots`` (safe mode), an existing file is read only inside them, through the capped reader.
+    ``digests`` receives the SHA-256 of each file's bytes, by the name its elements' origins carry.
     """
+    import hashlib
     import locale
     from xml.dom import expatbuilder
 
@@ -304,13 +318,19 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
         if roots is not None:
             roots.check(full)  # outside: refused whether or not something is there
         if roots is not None and os.path.lexists(full):
-            text = read_inside(roots, full).decode(locale.getpreferredencoding(False))  # as open() decodes
+            data = read_inside(roots, full)
+            digests[str(filename)] = hashlib.sha256(data).hexdigest()
+            text = data.decode(locale.getpreferredencoding(False))  # as open() decodes
             return Builder(str(filename)).parseString(text)
         try:
             with open(full) as handle:
                 text = handle.read()
         except OSError:
             return original_parse(inp, filename)  # raises xacro's own error, with its file stack
+        with contextlib.suppress(UserError):  # trusted mode: the same file's bytes, through the capped reader
+            from ar3cli.infra.safe_read import read_bytes
+
+            digests[str(filename)] = hashlib.sha256(read_bytes(Path(full))).hexdigest()
         return Builder(str(filename)).parseString(text)
 
     return parse
