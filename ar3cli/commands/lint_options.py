@@ -120,6 +120,13 @@ def linter_options(config: Any, select: list[str] | None = None, ignore: list[st
         raise UserError(str(exc)) from None
 
 
+def skipped_links_note(skipped: list[str]) -> str:
+    """The note for the symbolic links a folder's search left out (they lead out of the folder)."""
+    shown = ", ".join(skipped[:3]) + (f" and {len(skipped) - 3} more" if len(skipped) > 3 else "")
+    return (f"ar3cli: note: skipped {len(skipped)} symbolic link{'s' if len(skipped) != 1 else ''} to a file outside "
+            f"the folder searched ({shown}); name a file as PATH to lint it")
+
+
 def split_codes(items: list[str] | None) -> list[str]:
     """``--select``/``--ignore`` values, each comma-separated, as one list."""
     return [part for item in items or [] for part in item.split(",")]

@@ -32,6 +32,7 @@ from ar3cli.commands.lint_options import (
     WriteBaselineOption,
     linter_options,
     parse_targets,
+    skipped_links_note,
     srdf_disabled,
 )
 from ar3cli.commands.options import (
@@ -172,13 +173,6 @@ def _write_baseline(path: Path, results, fmt, follow_symlinks: bool = False) -> 
     data = {"baseline": str(path), "findings": count, "files_with_findings": files, "files": len(results)}
     finish(Report(data=data, lines=[line], errors=[r.error for r in results if r.error]),
            "json" if fmt == "json" else "text")
-
-
-def skipped_links_note(skipped: list[str]) -> str:
-    """The note for the symbolic links a folder's search left out (they lead out of the folder)."""
-    shown = ", ".join(skipped[:3]) + (f" and {len(skipped) - 3} more" if len(skipped) > 3 else "")
-    return (f"ar3cli: note: skipped {len(skipped)} symbolic link{'s' if len(skipped) != 1 else ''} to a file outside "
-            f"the folder searched ({shown}); name a file as PATH to lint it")
 
 
 def explain_rule(code: str, fmt) -> None:
