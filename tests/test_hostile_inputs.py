@@ -243,3 +243,34 @@ def test_a_folder_search_leaves_out_links_leading_out_of_it(cli, tmp_path):
                                           "searched (robots/out.urdf); name a file as PATH to lint it"]
     named = cli("lint-urdf", "-f", "json", "robots/out.urdf", cwd=tmp_path / "repo")
     assert [entry["path"] for entry in json.loads(named.stdout)["files"]] == ["robots/out.urdf"]
+
+
+# ---- the same file by many paths -----------------------------------------------------------------
+
+def test_a_mesh_reached_by_many_paths_is_read_once(tmp_path, monkeypatch):
+    """Two links ``a -> .`` and ``b -> .`` and 120 paths to one 20 MB OBJ (``a/b/a/m.obj``...) took
+    207 s of static lint: the mesh caches were keyed by the path. Now by the file's identity too."""
+    import itertools
+
+    from ar3cli.infra import file_cache
+    from ar3cli.lint.engine import LintOptions, lint_file
+    from ar3cli.urdf import meshinfo
+
+    monkeypatch.setenv("AR3CLI_NO_CACHE", "1")
+    for name in ("_DISK_CACHE", "_CONTENT_CACHE", "_HULL_CACHE"):
+        old = getattr(meshinfo, name)
+        monkeypatch.setattr(meshinfo, name, file_cache.FileFacts(old.name, old.version))
+    meshinfo._mesh_bounds.cache_clear()
+    (tmp_path / "m.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 2 3\nf 1 2 4\nf 1 3 4\nf 2 3 4\n")
+    (tmp_path / "a").symlink_to(".")
+    (tmp_path / "b").symlink_to(".")
+    paths = ["/".join(combo) + "/m.obj" for depth in (1, 2, 3, 4) for combo in itertools.product("ab", repeat=depth)]
+    shapes = "".join(f'<collision><geometry><mesh filename="{path}"/></geometry></collision>' for path in paths)
+    (tmp_path / "r.urdf").write_text(robot(f'<link name="base">{LINK_INERTIAL}{shapes}</link>'))
+    reads = []
+    original = meshinfo.read_mesh
+    monkeypatch.setattr(meshinfo, "read_mesh", lambda path: reads.append(path) or original(path))
+    options = LintOptions()
+    result = lint_file(tmp_path / "r.urdf", options.rules(), options)
+    assert result.error is None and len(paths) == 30
+    assert meshinfo._mesh_bounds.cache_info().currsize == 1 and len(reads) <= 2  # bounds, and the OBJ's statements
