@@ -274,3 +274,70 @@ def test_a_mesh_reached_by_many_paths_is_read_once(tmp_path, monkeypatch):
     result = lint_file(tmp_path / "r.urdf", options.rules(), options)
     assert result.error is None and len(paths) == 30
     assert meshinfo._mesh_bounds.cache_info().currsize == 1 and len(reads) <= 2  # bounds, and the OBJ's statements
+
+
+# ---- every file's check within time and memory ---------------------------------------------------
+
+def test_one_files_check_past_its_time_or_memory_is_one_line_and_the_batch_goes_on(tmp_path, monkeypatch):
+    """A single file was linted in ar3cli's own process, under no limit: a 6 KB xacro macro called
+    200 times grew past 6 GB and died with exit 3. Every file is now checked in a forked process with
+    the limits of every child (``--timeout`` per file, the memory cap): past either, the file gets one
+    line, and the other files their findings."""
+    import time
+
+    from ar3cli.infra import child_limits
+    from ar3cli.lint import engine
+
+    def greedy(ctx):
+        if ctx.model.path.name == "hungry.urdf":
+            yield from ()
+            bytearray(8 << 30)  # more than any child may map
+        if ctx.model.path.name == "slow.urdf":
+            time.sleep(60)
+        yield from ()
+
+    options = engine.LintOptions()
+    rules = [dataclasses.replace(rule, check=greedy) if rule.code == "G014" else rule for rule in options.rules()]
+    monkeypatch.setattr(engine.LintOptions, "rules", lambda self: rules)
+    monkeypatch.setenv(child_limits.MEMORY_VARIABLE, "1024")
+    monkeypatch.setattr(child_limits, "_timeout", 3.0)
+    for name in ("hungry", "slow", "good"):
+        (tmp_path / f"{name}.urdf").write_text(GOOD)
+    results = engine.lint_paths([tmp_path / f"{name}.urdf" for name in ("hungry", "slow", "good")], options,
+                                use_cache=False, jobs=2)
+    hungry, slow, good = results
+    assert hungry.error.endswith("hungry.urdf: checking it ran out of memory (the limit of a child process is 1 GB "
+                                 "more than it starts with; set AR3CLI_CHILD_MEMORY_MB to change it)")
+    assert slow.error.endswith("slow.urdf: checking it took longer than the limit of 3 s per file; raise --timeout "
+                               "(0: no limit) if the file is just large")
+    assert good.error is None and good.loaded
+
+
+def test_a_file_whose_findings_flood_the_output_is_one_line(tmp_path, monkeypatch):
+    from ar3cli.lint import engine
+
+    monkeypatch.setattr(engine, "MAX_FINDINGS_TEXT", 10_000)
+    names = "".join(f'<link name="orphan_{index}"/>' for index in range(300))
+    (tmp_path / "orphans.urdf").write_text(robot(names))
+    (tmp_path / "good.urdf").write_text(GOOD)
+    options = engine.LintOptions()
+    flood, good = engine.lint_paths([tmp_path / "orphans.urdf", tmp_path / "good.urdf"], options, use_cache=False)
+    assert flood.findings == [] and "more than ar3cli reports for one file" in flood.error
+    assert good.error is None
+
+
+@pytest.mark.parametrize(("command", "stage"), [(["info"], "summarising it"), (["diff", "old.urdf"], "comparing it"),
+                                                (["fix-joints", "--diff"], "linting the fixed file")])
+def test_in_process_work_on_a_file_has_the_limits_of_every_child(cli, tmp_path, command, stage):
+    """diff, info, report's summary and a fix's lint of its result ran in ar3cli's own process, under
+    no limit (a 1,000-child renamed star kept diff busy for half a minute, in the Action's diff step):
+    each runs in a child with the command's --timeout and the memory cap."""
+    from ar3cli.lint.rules.base import arm
+
+    text = arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 2"/>')  # J010: fix-joints has work to do
+    (tmp_path / "old.urdf").write_text(text)
+    (tmp_path / "new.urdf").write_text(text)
+    result = cli(*command, "new.urdf", "--timeout", "0.001", cwd=tmp_path)
+    assert result.code == 2, result.stdout + result.stderr
+    assert result.stderr.splitlines()[-1] == (f"ar3cli: error: new.urdf: timed out after 0.001 s while {stage}; "
+                                              "raise --timeout (0: no limit) if the file is just large")

@@ -281,7 +281,8 @@ def test_static_lint_does_not_import_numpy_pybullet_or_trimesh(tmp_path, pybulle
 
     (tmp_path / "r.urdf").write_text(arm())
     files = [str(tmp_path / "r.urdf"), str(pybullet_data_dir / "franka_panda" / "panda.urdf")]
-    code = ("import sys\nfrom ar3cli.cli import main\n"
+    code = ("import sys\nfrom ar3cli.cli import main\nfrom ar3cli.infra import process_pool\n"
+            "process_pool.can_fork = lambda: False\n"  # lint here, not in a worker: its imports and reads are seen
             f"try:\n    main(['lint-urdf', '--format', 'json', *{files!r}])\nexcept SystemExit:\n    pass\n"
             "from ar3cli.urdf.meshinfo import _mesh_bounds\nprint(_mesh_bounds.cache_info().currsize)\n"
             "print(sorted(m for m in ('numpy', 'pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")

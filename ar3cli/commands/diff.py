@@ -15,12 +15,14 @@ import typer
 from ar3cli.commands.options import (
     PackagePathOption,
     SeedOption,
+    TimeoutOption,
     XacroArgOption,
     finite_float,
     format_option,
     samples_option,
 )
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import ANNOTATIONS, MARKDOWN, REPORT, finish_as
 
 if TYPE_CHECKING:
@@ -67,6 +69,7 @@ def diff(
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     format: FormatOption = "text",
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Show what NEW changes about OLD's robot: links and joints added, removed or renamed, how far
     every end effector moved (home pose and random configurations) and which joint moved it, masses
@@ -84,10 +87,13 @@ def diff(
     limits = Tolerance(tolerance if tolerance_m is None else tolerance_m,
                        tolerance if tolerance_rad is None else tolerance_rad, tolerance)
     pairs = _pairs(sides or [], old_rev, changed_since, package_path, xacro_arg)
+    from ar3cli.infra.isolation import run_limited
+
     diffs, errors = [], []
     for old_spec, new_spec in pairs:
-        try:
-            diffs.append(_compare(old_spec, new_spec, limits, samples, seed, package_path, xacro_arg))
+        try:  # each pair in a child with the limits of every child: a file built to stall is one line
+            diffs.append(run_limited(lambda old_spec=old_spec, new_spec=new_spec: _compare(
+                old_spec, new_spec, limits, samples, seed, package_path, xacro_arg), new_spec.label, "comparing it"))
         except UserError as exc:
             if len(pairs) == 1:
                 raise

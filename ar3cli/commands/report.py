@@ -70,7 +70,7 @@ def report(
     lines: dict[str, list[str]] = {}
     data["lint"], linted = lint_document(path, source)
     model = source.load(path)
-    data["info"], lines["info"], lines["torques"] = _info(model, samples, seed, data["skipped"])
+    data["info"], lines["info"], lines["torques"] = _limited_info(model, path, samples, seed, data["skipped"])
     pictures = _pictures(model, lines.setdefault("pictures", []))
     data["renders"] = [{key: value for key, value in p.items() if key != "png"} for p in pictures]
     data["collisions"], lines["collisions"] = _attempt(lambda: _collisions(model, samples, seed),
@@ -96,6 +96,20 @@ def _attempt(work: Callable[[], tuple[T, list[str]]], key: str, skipped: dict[st
         skipped[key] = exc.message
         log(f"report: {key} left out: {exc.message}")
         return None, []
+
+
+def _limited_info(model, path: Path, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict, list[str], list[str]]:
+    """:func:`_info` in a child with the limits of every child (a file built to make the summary
+    take hours or gigabytes is one line); what it left out is added to ``skipped``."""
+    from ar3cli.infra.isolation import run_limited
+
+    def work() -> tuple[tuple[dict, list[str], list[str]], dict[str, str]]:
+        left_out: dict[str, str] = {}
+        return _info(model, samples, seed, left_out), left_out
+
+    made, left_out = run_limited(work, str(path), "summarising it")
+    skipped.update(left_out)
+    return made
 
 
 def _info(model, samples: int, seed: int, skipped: dict[str, str]) -> tuple[dict, list[str], list[str]]:

@@ -236,8 +236,11 @@ def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: 
             _check_parses(path, new)
         if args.diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
-        if result.changed:
-            result.remaining = remaining_findings(path, new, package_path)
+        if result.changed:  # a full lint of the result: in a child with the limits of every child
+            from ar3cli.infra.isolation import run_limited
+
+            result.remaining = run_limited(lambda path=path, new=new: remaining_findings(path, new, package_path),
+                                           str(path), "linting the fixed file")
         planned.append((result, new, model))
     writing = args.writes
     if writing:

@@ -196,24 +196,62 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it. ``skipped``
     receives the links a folder's search left out (:func:`collect_files`).
     """
-    from ar3cli.infra.process_pool import map_in_processes
+    from ar3cli.infra import process_pool
+    from ar3cli.infra.streaming_pool import stream
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
     files = collect_files(paths, skipped)
+    if not process_pool.can_fork():  # Windows, macOS: in this process, without limits
+        return [settle(lint_file(path, rules, options, cache), options) for path in files]
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
-    if workers <= 1:
-        return [settle(lint_file(path, rules, options, cache), options) for path in files]
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
-    order = balanced_order(sizes, workers)
-    outcomes = map_in_processes(job, [files[index] for index in order], workers, what="a lint worker")
+    largest_first = sorted(range(len(files)), key=lambda index: -sizes[index])
+    limit = file_time_limit(options)
     results: list[LintResult] = [None] * len(files)  # type: ignore[list-item]
-    for index, (result, learned) in zip(order, outcomes):
-        merge_learned(learned)
+    for index, (kind, payload) in stream(lambda index: job(files[index]), largest_first, workers, limit):
+        if kind == "ok":
+            result, learned = payload
+            merge_learned(learned)
+        elif kind == "interrupted":
+            raise KeyboardInterrupt
+        else:
+            result = LintResult(display_path(files[index]), False, [], _stopped(display_path(files[index]), kind,
+                                                                                 payload, limit))
         results[index] = settle(result, options)
     return results
+
+
+def file_time_limit(options: LintOptions) -> float | None:
+    """Seconds one file's check may take (None: no limit): the command's ``--timeout`` for its
+    static checks, plus as much again for each simulator ``--sim`` runs (each in a child of its own
+    with that limit)."""
+    from ar3cli.infra import child_limits
+
+    seconds = child_limits.timeout()
+    if seconds is None:
+        return None
+    return seconds * (1 + (len(options.engines) if options.sim else 0))
+
+
+def _stopped(shown: str, kind: str, payload: Any, limit: float | None) -> str:
+    """The one line for a file whose check did not come back: it ran past its time, out of memory,
+    its process died, or ar3cli failed on it (a bug)."""
+    from ar3cli.infra.child_limits import MEMORY_VARIABLE, describe_memory_limit
+
+    if kind == "timeout":
+        return (f"{shown}: checking it took longer than the limit of {limit:g} s per file; raise --timeout "
+                "(0: no limit) if the file is just large")
+    if kind == "out-of-memory":
+        return (f"{shown}: checking it ran out of memory (the limit of a child process is {describe_memory_limit()}; "
+                f"set {MEMORY_VARIABLE} to change it)")
+    if kind == "crash":
+        return f"{shown}: the process checking it died: {payload}"
+    if kind == "user-error":
+        return payload[0]
+    return f"{shown}: {internal_error('while checking it', RuntimeError(payload))}"
 
 
 def settle(result: LintResult, options: LintOptions) -> LintResult:
@@ -265,21 +303,6 @@ def _workers(jobs: int | None, sizes: list[int], sim: bool) -> int:
     return max(by_files, min(len(sizes), worker_count(None, sum(sizes), BYTES_PER_WORKER)))
 
 
-def balanced_order(sizes: list[int], workers: int) -> list[int]:
-    """Indices of the items in the order that gives round-robin dealing to ``workers`` processes
-    (:func:`~ar3cli.infra.process_pool.map_in_processes`: worker ``w`` takes positions ``w``,
-    ``w + workers``, ...) shares of about equal size: largest first, each round of ``workers``
-    dealt in the opposite direction of the one before (a snake draft). A robot's file size
-    follows its link and mesh count; dealt in command-line order, one process got the big robots
-    and the other waited."""
-    by_size = sorted(range(len(sizes)), key=lambda index: -sizes[index])
-    order: list[int] = []
-    for start in range(0, len(by_size), workers):
-        chunk = by_size[start:start + workers]
-        order += chunk if (start // workers) % 2 == 0 else chunk[::-1]
-    return order
-
-
 def _size(path: Path) -> int:
     """The file's size in bytes (0 when it cannot be read: its one-line finding is cheap)."""
     try:
@@ -288,11 +311,23 @@ def _size(path: Path) -> int:
         return 0
 
 
+MAX_FINDINGS_TEXT = 64 * 1024 * 1024
+"""Characters of findings (messages and hints) one file may hand back: a 20,000-link star's findings
+are ~6 MB. More is a file built to flood the output (every finding listing thousands of names):
+the file gets one error line instead, and ar3cli never holds or prints it."""
+
+
 def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions,
                          cache: ResultCache | None) -> tuple[LintResult, dict[str, Any]]:
     """:func:`lint_file`, plus what the on-disk caches learnt meanwhile (a worker never saves them:
-    its parent merges and saves)."""
-    return lint_file(path, rules, options, cache), take_learned()
+    its parent merges and saves); a result over :data:`MAX_FINDINGS_TEXT` stays in the worker."""
+    result = lint_file(path, rules, options, cache)
+    size = sum(len(f.message) + len(f.hint) for f in result.findings)
+    if size > MAX_FINDINGS_TEXT:
+        result = LintResult(result.path, result.loaded, [], f"{result.path}: its {len(result.findings)} findings "
+                            f"hold {size / 1e6:.0f} million characters, more than ar3cli reports for one file "
+                            f"({MAX_FINDINGS_TEXT / 1e6:.0f} million): a file built to flood the output?")
+    return result, take_learned()
 
 
 def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None:
