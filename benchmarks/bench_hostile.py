@@ -1,7 +1,8 @@
 """What a hostile pull request costs the gate: time and peak memory of whole ``ar3cli`` processes.
 
 Builds, in a temporary folder, the inputs issue 34 reproduced against the CI gate, and runs the
-command the gate runs on each, as a separate process:
+command the gate runs on each, as a separate process (``python -m ar3cli`` of this checkout, or of
+``--code DIR``):
 
 * ``orphans-N``: a robot of N links and no joints (N roots: S005 names every one of them in each of
   its findings), ``lint-urdf --format github`` (annotations, and the step summary file);
@@ -22,6 +23,8 @@ Usage (inside the project's venv)::
     python benchmarks/bench_hostile.py --only orphans    # the cases whose name starts with it
     python benchmarks/bench_hostile.py --write-only DIR  # just write the inputs
     python benchmarks/bench_hostile.py --timeout 600     # ar3cli's --timeout (default: its own, 120 s)
+    python benchmarks/bench_hostile.py --code ../main    # another checkout (careful: before issue 34,
+                                                         # orphans-20000 grew past 20 GB)
 """
 
 from __future__ import annotations
@@ -107,11 +110,12 @@ def write_cases(folder: Path) -> dict[str, tuple[list[str], Path]]:
     return cases
 
 
-def run(args: list[str], cwd: Path, timeout: float | None) -> tuple[int, float, float, str]:
-    """(exit code, wall seconds, peak MB of the process and its children, its last stderr line)."""
-    command = [*_timing.ar3cli_command(), *args, *(["--timeout", f"{timeout:g}"] if timeout is not None else [])]
+def run(args: list[str], cwd: Path, timeout: float | None, code: Path) -> tuple[int, float, float, str]:
+    """(exit code, wall seconds, peak MB of the process and its children, its last stderr line) of
+    ``python -m ar3cli ARGS`` run from the checkout ``code``."""
+    command = [sys.executable, "-m", "ar3cli", *args, *(["--timeout", f"{timeout:g}"] if timeout is not None else [])]
     summary = cwd / "step_summary.md"
-    env = {**_timing.BASE_ENV, "GITHUB_STEP_SUMMARY": str(summary)}
+    env = {**_timing.BASE_ENV, "GITHUB_STEP_SUMMARY": str(summary), "PYTHONPATH": str(code)}
     with tempfile.TemporaryFile() as errors:
         started = time.perf_counter()
         process = subprocess.Popen(command, cwd=cwd, env=env, stdout=subprocess.DEVNULL, stderr=errors,
@@ -130,6 +134,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--only", default="", help="run the cases whose name starts with this")
     parser.add_argument("--timeout", type=float, default=None, help="ar3cli's --timeout (default: its own)")
     parser.add_argument("--write-only", type=Path, default=None, help="write the inputs into this folder and stop")
+    parser.add_argument("--code", type=Path, default=_timing.REPO,
+                        help="the ar3cli checkout to run (default: the one holding this script)")
     options = parser.parse_args(argv)
     if options.write_only is not None:
         options.write_only.mkdir(parents=True, exist_ok=True)
@@ -139,13 +145,14 @@ def main(argv: list[str] | None = None) -> None:
     report: Callable[[str], None] = print
     with tempfile.TemporaryDirectory(prefix="ar3cli-hostile-") as folder:
         cases = write_cases(Path(folder))
-        report(f"{os.cpu_count()} CPUs; peak MB: the largest resident set of ar3cli and of each child it waited for")
+        report(f"ar3cli from {options.code}, {os.cpu_count()} CPUs; peak MB: the largest resident set of ar3cli and of "
+               "each child it waited for")
         report("| case | command | exit | wall s | peak MB | last stderr line |")
         report("| --- | --- | --- | --- | --- | --- |")
         for name, (args, cwd) in cases.items():
             if not name.startswith(options.only):
                 continue
-            code, seconds, peak, last = run(args, cwd, options.timeout)
+            code, seconds, peak, last = run(args, cwd, options.timeout, options.code)
             report(f"| {name} | ar3cli {' '.join(args)} | {code} | {seconds:.1f} | {peak:.0f} | {last[:160]} |")
 
 
