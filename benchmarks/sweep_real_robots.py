@@ -20,7 +20,8 @@ sweep's own temporary folder (your ~/.cache/ar3cli is not touched). Every run is
 clean           exit 0 or 1, stdout is JSON without NaN/Infinity, and the command-specific checks hold
 user error      exit 2 with a short stderr message and no traceback (expected for bad input)
 crash           killed by a signal (SIGSEGV, SIGABRT, ...)
-internal error  exit 3, a traceback, exit 2 with no or a long message, invalid JSON, NaN/Infinity in
+internal error  exit 3, a traceback, exit 2 with no or a long message or one naming an internal error
+                (a rule that failed on one file), invalid JSON, NaN/Infinity in
                 JSON, or any other exit code
 silent wrong    looks clean but is not: render wrote a PNG with no robot in it (or none at all),
                 fk-verify's JSON holds NaN or contradicts its exit code, lint's exit code
@@ -399,6 +400,8 @@ def classify(command: Command, outcome: Outcome, run_dir: Path) -> tuple[str, st
         return "internal error", f"exit {rc} with a traceback"
     if rc == 2:
         lines = [line for line in outcome.stderr.splitlines() if line.strip()]
+        if any("internal error" in line for line in lines):  # a rule's bug on one file: the batch went on
+            return "internal error", "exit 2 naming an internal error"
         if not lines:
             return "internal error", "exit 2 with no message"
         if len(lines) > SHORT_STDERR_LINES:

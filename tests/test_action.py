@@ -88,8 +88,9 @@ class ActionRun:
         return any(step["outcome"] == "failure" for step in self.steps.values())
 
 
-def run_action(workspace: Path, tmp_path: Path, **inputs: str) -> ActionRun:
-    """Run action.yml's steps as a composite action would, in ``workspace``, with these inputs."""
+def run_action(workspace: Path, tmp_path: Path, github: dict | None = None, **inputs: str) -> ActionRun:
+    """Run action.yml's steps as a composite action would, in ``workspace``, with these inputs
+    (``github``: more of the github context, such as the pull request's ``event``)."""
     action = _action()
     declared = action["inputs"]
     assert set(inputs) <= set(declared), f"undeclared inputs {set(inputs) - set(declared)}"
@@ -98,7 +99,7 @@ def run_action(workspace: Path, tmp_path: Path, **inputs: str) -> ActionRun:
     summary = tmp_path / "step_summary.md"
     summary.touch()
     context = {"inputs": {name: str(spec.get("default", "")) for name, spec in declared.items()} | inputs,
-               "github": {"action_path": str(REPO), "workspace": str(workspace)},
+               "github": {"action_path": str(REPO), "workspace": str(workspace), **(github or {})},
                "runner": {"temp": str(runner_temp), "os": "Linux"},
                "steps": {}}
     result = ActionRun(outputs={}, steps=context["steps"], workspace=workspace)
@@ -290,6 +291,28 @@ def test_upload_sarif_writes_the_default_file_and_would_upload_it(robots, tmp_pa
     assert json.loads((robots / "ar3cli.sarif").read_text(encoding="utf-8"))["runs"][0]["results"]
     assert run.steps["upload-sarif"]["outcome"] == "success"
     assert run.would_use["github/codeql-action/upload-sarif"]["sarif_file"] == "ar3cli.sarif"
+
+
+def test_a_pull_request_from_a_fork_cannot_silence_the_gate(robots, tmp_path):
+    """A pyproject.toml with ``ignore = ["ALL"]`` (or ``ar3cli: ignore`` comments) committed in a
+    pull request turned a failing file into "passed". From another repository the action lints
+    ``--isolated`` (its own branches keep the configuration), and the SARIF run does the same."""
+    (robots / "pyproject.toml").write_text('[tool.ar3cli.lint]\nignore = ["ALL"]\n', encoding="utf-8")
+    fork = {"repository": "owner/robot", "event": {"pull_request": {"head": {"repo": {"full_name": "someone/robot"}}}}}
+    own = {"repository": "owner/robot", "event": {"pull_request": {"head": {"repo": {"full_name": "owner/robot"}}}}}
+    (tmp_path / "fork").mkdir()
+    isolated = run_action(robots, tmp_path / "fork", github=fork, paths="robots", **{"upload-sarif": "true"})
+    assert isolated.failed and isolated.outputs["exit-code"] == "1", isolated.stderr
+    assert "--isolated" in isolated.stderr and isolated.stdout.count("::error file=robots/broken.urdf") == 3
+    sarif = json.loads((robots / "ar3cli.sarif").read_text(encoding="utf-8"))
+    assert not any("suppressions" in result for result in sarif["runs"][0]["results"])
+    (tmp_path / "own").mkdir()
+    configured = run_action(robots, tmp_path / "own", github=own, paths="robots")
+    assert not configured.failed, configured.stderr
+    assert "3 suppressed (3 by pyproject.toml)" in configured.stdout and "3 suppressed" in configured.summary
+    (tmp_path / "forced").mkdir()
+    forced = run_action(robots, tmp_path / "forced", github=own, paths="robots", isolated="true")
+    assert forced.failed
 
 
 def test_missing_path_is_exit_code_2(robots, tmp_path):

@@ -36,6 +36,15 @@ def write_stl(path: Path, size: float) -> None:
     path.write_bytes(b"t".ljust(80) + struct.pack("<I", 1) + struct.pack("<12f", 0, 0, 1, *corners) + b"\0\0")
 
 
+@pytest.fixture(autouse=True)
+def in_this_process(monkeypatch) -> None:
+    """Lint here, not in a forked worker, so that the tests see what the linter loads (a worker's
+    answers and cache entries come back the same: tests/test_hostile_inputs.py)."""
+    from ar3cli.infra import process_pool
+
+    monkeypatch.setattr(process_pool, "can_fork", lambda: False)
+
+
 @pytest.fixture
 def store(tmp_path, monkeypatch) -> Path:
     """A private, empty result store (and cache folder) for one test; returns the folder."""

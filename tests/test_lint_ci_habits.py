@@ -147,6 +147,7 @@ def test_baseline_hides_known_findings_and_fails_on_new_ones(cli, tmp_path):
     doc = _json(cli("lint-urdf", "models", "--baseline", "ci/baseline.json", "-f", "json", cwd=tmp_path))
     assert [(f["rule"], "'jc'" in f["message"]) for f in doc["findings"]] == [("J001", True)]
     assert doc["summary"]["baselined"] == 3 and doc["summary"]["failed"] is True
+    assert doc["summary"]["suppressed"]["baseline"] == 3 and {f["suppressed_by"] for f in doc["suppressed"]} == {"baseline"}
 
     # from another working directory, and with a relative path to the baseline
     elsewhere = cli("lint-urdf", str(models / "b.urdf"), "--baseline", str(tmp_path / "ci" / "baseline.json"),

@@ -21,7 +21,7 @@ def test_json_document_and_exit_code(cli, write_urdf):
     result = cli("lint-urdf", str(path), "--format", "json")
     assert result.code == 1, result.stderr
     doc = json.loads(result.stdout)
-    assert set(doc) == {"files", "findings", "summary"}
+    assert set(doc) == {"files", "findings", "summary", "suppressed"}
     (finding,) = [f for f in doc["findings"] if f["rule"] == "J001"]
     assert set(finding) == {"path", "line", "column", "rule", "severity", "message", "hint", "fixed_by"}
     assert finding["severity"] == "error" and finding["line"] == 5 and "'j1'" in finding["message"]
@@ -160,6 +160,52 @@ def test_inline_and_file_level_suppression(cli, write_urdf):
                                                             "--format", "json").stdout)["findings"]}
 
 
+def test_ignore_file_counts_only_inside_a_comment(cli, tmp_path):
+    """``ar3cli:ignore-file`` anywhere in the bytes silenced the file, even as the robot's name."""
+    (tmp_path / "named.urdf").write_text(NO_LIMIT.replace('<robot name="r">', '<robot name="ar3cli:ignore-file">'))
+    (tmp_path / "text.urdf").write_text(NO_LIMIT.replace("</robot>", "<gazebo>ar3cli: ignore-file</gazebo></robot>"))
+    (tmp_path / "before.urdf").write_text(NO_LIMIT.replace("<robot", "<!-- ar3cli: ignore-file[J001] -->\n<robot"))
+    (tmp_path / "b.urdf.xacro").write_text(NO_LIMIT.replace('<robot name="r">', '<robot name="r" xmlns:xacro='
+                                           '"http://www.ros.org/wiki/xacro"><!-- ar3cli: ignore-file[J001] -->'))
+    doc = json.loads(cli("lint-urdf", "named.urdf", "text.urdf", "before.urdf", "b.urdf.xacro", "-f", "json",
+                         cwd=tmp_path).stdout)
+    j001 = {f["path"] for f in doc["findings"] if f["rule"] == "J001"}
+    assert j001 == {"named.urdf", "text.urdf"}
+    assert {(f["path"], f["suppressed_by"]) for f in doc["suppressed"]} == {("before.urdf", "comment"),
+                                                                             ("b.urdf.xacro", "comment")}
+
+
+def test_every_run_says_what_was_suppressed_and_isolated_applies_nothing(cli, tmp_path):
+    """A pyproject.toml with ``ignore = ["ALL"]`` or an ``ar3cli: ignore`` comment turned a failing
+    file into "passed" and nothing said so: the summary line, JSON, SARIF and the GitHub step summary
+    count the suppressed findings by what suppressed them; ``--isolated`` applies neither."""
+    (tmp_path / "a.urdf").write_text(NO_LIMIT)
+    (tmp_path / "b.urdf").write_text(NO_LIMIT.replace('<robot name="r">', '<robot name="r"><!-- ar3cli: ignore -->'))
+    (tmp_path / "pyproject.toml").write_text('[tool.ar3cli.lint]\nignore = ["J001"]\n[tool.ar3cli.lint.severity]\n'
+                                             'J008 = "info"\n')
+    text = cli("lint-urdf", "a.urdf", "b.urdf", "--no-cache", cwd=tmp_path)
+    assert text.code == 0, text.stdout
+    assert text.stdout.splitlines()[-1] == (
+        "passed: 2 files checked, 0 errors, 0 warnings, 0 info; 2 clean; 2 suppressed (1 by pyproject.toml, 1 by "
+        "comments in the files) (fail-on: error)")
+    summary = json.loads(cli("lint-urdf", "a.urdf", "b.urdf", "-f", "json", cwd=tmp_path).stdout)["summary"]
+    assert summary["suppressed"] == {"config": 1, "comment": 1, "baseline": 0}
+    sarif = json.loads(cli("lint-urdf", "a.urdf", "b.urdf", "-f", "sarif", cwd=tmp_path).stdout)
+    kinds = sorted(r["suppressions"][0]["kind"] for r in sarif["runs"][0]["results"] if "suppressions" in r)
+    assert kinds == ["external", "inSource"]
+    step_summary = tmp_path / "summary.md"
+    github = cli("lint-urdf", "a.urdf", "b.urdf", "-f", "github", cwd=tmp_path,
+                 env={"GITHUB_STEP_SUMMARY": str(step_summary)})
+    assert github.code == 0 and "2 suppressed (1 by pyproject.toml" in step_summary.read_text()
+    isolated = cli("lint-urdf", "a.urdf", "b.urdf", "--isolated", "-f", "json", cwd=tmp_path)
+    document = json.loads(isolated.stdout)
+    assert isolated.code == 1 and document["summary"]["suppressed"] == {"config": 0, "comment": 0, "baseline": 0}
+    assert sorted(f["path"] for f in document["findings"] if f["rule"] == "J001") == ["a.urdf", "b.urdf"]
+    (tmp_path / "pyproject.toml").write_text('[tool.ar3cli.lint.severity]\nJ001 = "info"\n')
+    lowered = cli("lint-urdf", "a.urdf", cwd=tmp_path)
+    assert lowered.code == 0 and "; 1 made less severe by pyproject.toml" in lowered.stdout
+
+
 def test_folders_are_searched_and_xacro_expanded(cli, tmp_path):
     (tmp_path / "sub").mkdir()
     (tmp_path / "sub" / "a.urdf").write_text(NO_LIMIT)
@@ -242,7 +288,8 @@ def test_static_lint_does_not_import_numpy_pybullet_or_trimesh(tmp_path, pybulle
 
     (tmp_path / "r.urdf").write_text(arm())
     files = [str(tmp_path / "r.urdf"), str(pybullet_data_dir / "franka_panda" / "panda.urdf")]
-    code = ("import sys\nfrom ar3cli.cli import main\n"
+    code = ("import sys\nfrom ar3cli.cli import main\nfrom ar3cli.infra import process_pool\n"
+            "process_pool.can_fork = lambda: False\n"  # lint here, not in a worker: its imports and reads are seen
             f"try:\n    main(['lint-urdf', '--format', 'json', *{files!r}])\nexcept SystemExit:\n    pass\n"
             "from ar3cli.urdf.meshinfo import _mesh_bounds\nprint(_mesh_bounds.cache_info().currsize)\n"
             "print(sorted(m for m in ('numpy', 'pybullet', 'trimesh', 'yourdfpy') if m in sys.modules))")

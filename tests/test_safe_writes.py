@@ -220,3 +220,81 @@ def test_fix_collision_does_not_follow_a_planted_collision_folder(cli, tmp_path)
     result = cli("fix-collision", str(path), "--resolution", "20000", "--no-verify")
     assert result.code == 0, result.stdout + result.stderr
     assert sorted(p.name for p in (repo / "parts" / "base").iterdir())[0] == "part_00.obj"
+
+
+FIFO = pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="needs FIFOs")
+OUTPUTS = [
+    ["sample-collisions", str(ROBOT), "-n", "10", "--srdf"],
+    ["sample-collisions", str(ROBOT), "-n", "10", "--pybullet-filter"],
+    ["sample-collisions", str(ROBOT), "-n", "10", "--png"],
+    ["fix-continuous", str(ROBOT), "--no-verify", "-o"],
+    ["render", str(ROBOT), "-o"],
+    ["report", str(ROBOT), "-n", "2", "-o"],
+    ["info", str(ROBOT), "--png"],
+    ["grasp-demo", "--record"],
+    ["lint-urdf", str(ROBOT), "--write-baseline"],
+]
+
+
+@FIFO
+@pytest.mark.parametrize("args", OUTPUTS, ids=["srdf", "pybullet-filter", "heat-map-png", "fixer-output", "render",
+                                               "report", "info-png", "grasp-record", "baseline"])
+def test_an_output_that_is_a_fifo_is_refused_not_replaced(cli, tmp_path, args):
+    """``render -o FIFO`` replaced the FIFO with a regular file (as root, ``-o /dev/null`` replaced
+    the system's /dev/null): an existing output that is not a regular file is one line, exit 2."""
+    suffix = {"-o": ".png", "--png": ".png", "--record": ".gif"}.get(args[-1], "")
+    fifo = tmp_path / (("out.urdf" if args[0].startswith("fix-") else "out.html" if args[0] == "report" else "out")
+                       if not suffix else f"out{suffix}")
+    os.mkfifo(fifo)
+    result = cli(*args, str(fifo), timeout=120)
+    assert result.code == 2, result.stdout + result.stderr
+    lines = result.stderr.strip().splitlines()
+    assert lines[-1] == f"ar3cli: error: {fifo}: exists and is not a regular file (a FIFO); refusing to replace it: " \
+                        "give the name of a file", result.stderr
+    assert stat_kind(fifo) == "fifo"
+
+
+def stat_kind(path: Path) -> str:
+    import stat
+
+    mode = os.lstat(path).st_mode
+    return "fifo" if stat.S_ISFIFO(mode) else "link" if stat.S_ISLNK(mode) else "file"
+
+
+def test_a_device_is_refused_by_the_one_check(tmp_path):
+    with pytest.raises(UserError, match=r"^/dev/null: exists and is not a regular file \(a device\)"):
+        check_writable(Path("/dev/null"))
+    with pytest.raises(UserError, match="cannot write: File name too long"):
+        check_writable(tmp_path / ("x" * 300))
+
+
+@FIFO
+def test_scan_report_keep_list_and_scan_store_follow_the_same_rules(cli, tmp_path, planted):
+    """``scan --store`` followed a planted symlink (SQLite writes in place, not through the atomic
+    writer): the store and the files SQLite keeps beside it are checked by the same rules."""
+    repo, victim = planted
+    (repo / "robots").mkdir()
+    shutil.copyfile(ROBOT, repo / "robots" / "r.urdf")
+    link = plant(repo, "scan.sqlite", victim)
+    result = cli("scan", "robots", "--store", "scan.sqlite", cwd=repo)
+    assert result.code == 2
+    one_line_refusal(result.stderr, Path("scan.sqlite"))
+    assert victim.read_bytes() == PRECIOUS and link.is_symlink()
+    link.unlink()
+    side = plant(repo, "scan.sqlite-wal", victim)
+    result = cli("scan", "robots", "--store", "scan.sqlite", cwd=repo)
+    assert result.code == 2
+    assert result.stderr.strip().splitlines() == [
+        "ar3cli: error: scan.sqlite-wal: SQLite's wal file of the store is not a regular file (a symbolic link, "
+        "FIFO or device); refusing to write through it: remove it"]
+    assert victim.read_bytes() == PRECIOUS and side.is_symlink() and not (repo / "scan.sqlite").exists()
+    side.unlink()
+    (repo / "scan.sqlite").touch(mode=0o640)
+    os.chmod(repo / "scan.sqlite", 0o640)
+    result = cli("scan", "robots", "--store", "scan.sqlite", cwd=repo)
+    assert result.code == 0, result.stderr
+    assert (repo / "scan.sqlite").stat().st_mode & 0o777 == 0o640  # written in place: its mode kept
+    os.mkfifo(repo / "keep.txt")
+    result = cli("scan-report", "scan.sqlite", "--keep-list", "keep.txt", cwd=repo)
+    assert result.code == 2 and "keep.txt: exists and is not a regular file (a FIFO)" in result.stderr
+    assert stat_kind(repo / "keep.txt") == "fifo"

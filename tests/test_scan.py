@@ -153,7 +153,7 @@ def _work(item: str) -> str:
 
 
 def test_the_pool_streams_each_item_once_with_crash_and_timeout_outcomes() -> None:
-    from ar3cli.scan.pool import stream
+    from ar3cli.infra.streaming_pool import stream
 
     items = ["a", "crash", "b", "slow", "c", "d"]
     outcomes = dict(stream(_work, items, workers=2, timeout=1.0))

@@ -24,14 +24,18 @@ MOVED_SHOWN = 6
 
 @question
 def summary(analysis: RobotAnalysis) -> Summary:
-    """``info``'s summary: tree, joints, DOF, masses, centre of mass and box at the zero configuration, meshes."""
+    """``info``'s summary: tree, joints, DOF, masses, centre of mass and box at the zero configuration,
+    meshes; computed in a child with the limits of every child (a file built to make it take hours or
+    gigabytes is one line), as ``ar3cli info`` does."""
     from ar3cli.info.summary import summarize
+    from ar3cli.infra.isolation import run_limited
     from ar3cli.kinematics.fk import urdf_link_frames
 
     def zero_frames(model):
         return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
 
-    return summarize(analysis.require_model(), zero_frames)
+    model = analysis.require_model()
+    return run_limited(lambda: summarize(model, zero_frames), analysis.shown_path, "summarising it")
 
 
 @question

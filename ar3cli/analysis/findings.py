@@ -53,15 +53,15 @@ def findings(analysis: RobotAnalysis) -> LintAnswer:
 
 def _lint(analysis: RobotAnalysis, sim: bool) -> LintAnswer:
     from ar3cli.lint.document import exit_code, lint_json
-    from ar3cli.lint.engine import lint_model, load_failure, summarize, unloaded_result
+    from ar3cli.lint.engine import lint_model, load_failure, settle, summarize, unloaded_result
 
     options = analysis.settings.lint_options(sim)
     shown = analysis.shown_path
     if analysis.model is None:
         message = analysis.load_error.message if analysis.load_error else "not loaded"
-        result = unloaded_result(load_failure(analysis.path, shown, message), options)
+        result = settle(unloaded_result(load_failure(analysis.path, shown, message), options), options)
     else:
-        result = lint_model(analysis.model, shown, options.rules(), options)
+        result = settle(lint_model(analysis.model, shown, options.rules(), options), options)
     summary = summarize([result], analysis.settings.fail_on)
     summary["exit_code"] = exit_code(summary)
     return LintAnswer(result, summary, lint_json([result], summary), sim)

@@ -32,6 +32,9 @@ class RobotReport:
     data: dict[str, Any]
     lines: dict[str, list[str]] = field(default_factory=dict)
     findings: list[Finding] = field(default_factory=list)
+    sources: dict[str, str] = field(default_factory=dict)
+    """The files whose lines the page may show with the findings, with the digest of the bytes linted
+    (:attr:`~ar3cli.lint.engine.LintResult.sources`: never a file reached through a link out of the tree)."""
     pictures: list[dict[str, Any]] = field(default_factory=list)
 
 
@@ -49,7 +52,7 @@ def robot_report(analysis: RobotAnalysis) -> RobotReport:
                             "skipped": skipped, "cross_check": None}
     made = RobotReport(data)
     lint = findings.findings(analysis)
-    data["lint"], made.findings = lint.document, lint.findings
+    data["lint"], made.findings, made.sources = lint.document, lint.findings, lint.result.sources
     home = _attempt(lambda: facts.home_pose(analysis), "home", skipped)
     data["home"] = home.to_dict() if home is not None else None
 

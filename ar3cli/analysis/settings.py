@@ -57,11 +57,8 @@ class AnalysisSettings:
         configuration (``sim``: the PyBullet rules too, as ``--sim``)."""
         from ar3cli.lint.engine import LintOptions
 
-        config = self.config
-        options = LintOptions(select=config.select or ["ALL"], ignore=list(config.ignore),
-                              per_file_ignores=dict(config.per_file_ignores), severity=dict(config.severity),
-                              sim=sim, package_paths=self.packages, xacro_args=self.xacro_args,
-                              srdf_disabled=self.srdf_disabled)
+        options = LintOptions.configured(self.config, sim=sim, package_paths=self.packages,
+                                         xacro_args=self.xacro_args, srdf_disabled=self.srdf_disabled, sources=True)
         if self.targets is not None:
             options.targets = self.targets
         return options

@@ -8,20 +8,25 @@ forward kinematics to the diff (feature packages do not import each other).
 
 from __future__ import annotations
 
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Optional
 
 import typer
 
 from ar3cli.commands.options import (
     PackagePathOption,
     SeedOption,
+    TimeoutOption,
     XacroArgOption,
     finite_float,
     format_option,
     samples_option,
 )
 from ar3cli.errors import UserError
+from ar3cli.infra.child_limits import DEFAULT_TIMEOUT_S
 from ar3cli.output.formats import ANNOTATIONS, MARKDOWN, REPORT, finish_as
+
+if TYPE_CHECKING:
+    from ar3cli.robot_diff.git_source import SideSpec
 
 KINDS = (ANNOTATIONS, MARKDOWN, REPORT)
 """A diff is a table report with a Markdown form and workflow annotations."""
@@ -29,7 +34,11 @@ KINDS = (ANNOTATIONS, MARKDOWN, REPORT)
 SidesArgument = Annotated[Optional[list[str]], typer.Argument(
     metavar="OLD NEW", show_default=False,
     help="Two robot files, each a path or REV:path (the file as git revision REV holds it, read without a "
-         "checkout). With --changed-since: the files or folders to search (default: the current folder).")]
+         "checkout; REV:path is a revision whenever REV resolves in git, ./REV:path a file). With --old-rev: NEW "
+         "alone. With --changed-since: the files or folders to search (default: the current folder).")]
+OldRevOption = Annotated[Optional[str], typer.Option(
+    "--old-rev", metavar="REV", show_default=False,
+    help="OLD is NEW's file as git revision REV holds it (the same as OLD = REV:NEW, spelled out).")]
 ChangedSinceOption = Annotated[Optional[str], typer.Option(
     "--changed-since", metavar="REF", show_default=False,
     help="Compare every robot file that changed since the git ref REF (or uses a changed file, as lint-urdf "
@@ -50,6 +59,7 @@ FormatOption = format_option(KINDS, "DiffFormat")
 
 def diff(
     sides: SidesArgument = None,
+    old_rev: OldRevOption = None,
     changed_since: ChangedSinceOption = None,
     samples: SamplesOption = 100,
     seed: SeedOption = 0,
@@ -59,6 +69,7 @@ def diff(
     package_path: PackagePathOption = None,
     xacro_arg: XacroArgOption = None,
     format: FormatOption = "text",
+    timeout: TimeoutOption = DEFAULT_TIMEOUT_S,
 ) -> None:
     """Show what NEW changes about OLD's robot: links and joints added, removed or renamed, how far
     every end effector moved (home pose and random configurations) and which joint moved it, masses
@@ -75,11 +86,14 @@ def diff(
         raise UserError("--tolerance, --tolerance-m and --tolerance-rad must be zero or positive numbers")
     limits = Tolerance(tolerance if tolerance_m is None else tolerance_m,
                        tolerance if tolerance_rad is None else tolerance_rad, tolerance)
-    pairs = _pairs(sides or [], changed_since, package_path, xacro_arg)
+    pairs = _pairs(sides or [], old_rev, changed_since, package_path, xacro_arg)
+    from ar3cli.infra.isolation import run_limited
+
     diffs, errors = [], []
     for old_spec, new_spec in pairs:
-        try:
-            diffs.append(_compare(old_spec, new_spec, limits, samples, seed, package_path, xacro_arg))
+        try:  # each pair in a child with the limits of every child: a file built to stall is one line
+            diffs.append(run_limited(lambda old_spec=old_spec, new_spec=new_spec: _compare(
+                old_spec, new_spec, limits, samples, seed, package_path, xacro_arg), new_spec.label, "comparing it"))
         except UserError as exc:
             if len(pairs) == 1:
                 raise
@@ -87,12 +101,31 @@ def diff(
     _finish(diffs, errors, limits, samples, seed, format)
 
 
-def _pairs(sides: list[str], changed_since: str | None, package_path, xacro_arg) -> list[tuple[str | None, str]]:
-    """(OLD spec or None for a file REF does not have, NEW spec) of every robot to compare."""
+def _pairs(sides: list[str], old_rev: str | None, changed_since: str | None, package_path,
+           xacro_arg) -> list[tuple[SideSpec | None, SideSpec]]:
+    """(OLD or None for a file REF does not have, NEW) of every robot to compare; how a ``REV:path``
+    argument was read is said on stderr (a revision whenever REV resolves in git)."""
+    from ar3cli.output.report import log
+    from ar3cli.robot_diff.git_source import SideSpec, read_spec
+
+    if old_rev is not None and changed_since is not None:
+        raise UserError("--old-rev and --changed-since both choose OLD: give one")
+    if old_rev is not None:
+        if len(sides) != 1:
+            raise UserError(f"with --old-rev, diff takes one robot file, NEW (got {len(sides)})")
+        new, note = read_spec(sides[0])
+        if note:
+            log(f"ar3cli: note: NEW {note}")
+        return [(SideSpec.at(old_rev, new.path), new)]
     if changed_since is None:
         if len(sides) != 2:
-            raise UserError(f"diff takes two robot files, OLD and NEW (got {len(sides)}); or --changed-since REF")
-        return [(sides[0], sides[1])]
+            raise UserError(f"diff takes two robot files, OLD and NEW (got {len(sides)}); or --old-rev REV NEW, or "
+                            "--changed-since REF")
+        read = [read_spec(side) for side in sides]
+        for which, (_, note) in zip(("OLD", "NEW"), read):
+            if note:
+                log(f"ar3cli: note: {which} {note}")
+        return [(read[0][0], read[1][0])]
     from pathlib import Path
 
     from ar3cli.lint.changed import select_changed
@@ -102,19 +135,21 @@ def _pairs(sides: list[str], changed_since: str | None, package_path, xacro_arg)
     packages, arguments = read_specs(package_path, xacro_arg)
     selection = select_changed([Path(side) for side in sides or ["."]], changed_since, packages, arguments)
     parts = {used for users in selection.dependents.values() for used in users}  # compared through their users
-    return [(_at_ref(changed_since, path), display_path(path)) for path in selection.files
-            if display_path(path) not in parts]
+    return [(_at_ref(changed_since, display_path(path)), SideSpec(display_path(path), display_path(path)))
+            for path in selection.files if display_path(path) not in parts]
 
 
-def _at_ref(ref: str, path) -> str | None:
-    """``REF:path`` when REF holds the file, else None (the file was added since)."""
-    from ar3cli.robot_diff.git_source import exists_at, repository_path, resolve_commit
+def _at_ref(ref: str, path: str) -> SideSpec | None:
+    """``path`` as REF holds it when REF has the file, else None (the file was added since): a
+    revision by construction, never a file that happens to be named ``REF:path``."""
+    from ar3cli.robot_diff.git_source import SideSpec, exists_at, repository_path, resolve_commit
 
-    root, inside = repository_path(str(path))
-    return f"{ref}:{path}" if exists_at(root, resolve_commit(root, ref), inside) else None
+    root, inside = repository_path(path)
+    return SideSpec.at(ref, path) if exists_at(root, resolve_commit(root, ref), inside) else None
 
 
-def _compare(old_spec: str | None, new_spec: str, limits, samples: int, seed: int, package_path, xacro_arg):
+def _compare(old_spec: SideSpec | None, new_spec: SideSpec, limits, samples: int, seed: int, package_path,
+             xacro_arg):
     """Load both sides (a revision from its temporary copy), lint them and diff them."""
     from ar3cli.kinematics import fk
     from ar3cli.robot_diff.compare import compare_models
@@ -123,7 +158,8 @@ def _compare(old_spec: str | None, new_spec: str, limits, samples: int, seed: in
     from ar3cli.urdf.loading import load_with_specs
 
     if old_spec is None:
-        return RobotDiff("(none)", new_spec, [Change("structure", "robot file", "added", new=new_spec, file=new_spec)])
+        label = new_spec.label
+        return RobotDiff("(none)", label, [Change("structure", "robot file", "added", new=label, file=label)])
     with open_side(old_spec) as old_side, open_side(new_spec) as new_side:
         models = []
         for side in (old_side, new_side):

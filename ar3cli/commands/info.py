@@ -50,29 +50,18 @@ def info(
     the gravity torque check (PyBullet), --png a picture of the kinematic tree.
     """
     from ar3cli.info.presentation import report
-    from ar3cli.info.summary import summarize
-    from ar3cli.kinematics.fk import urdf_link_frames
+    from ar3cli.infra.isolation import run_limited
 
     if png is not None:
         png = _check_png(png, follow_symlinks)
-
-    def zero_frames(model):
-        return {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()}
-
-    model = source.load(path)
-    from ar3cli.urdf.macro_library import macro_library
-
-    library = macro_library(model)
+    source.specs()  # this run's xacro policy, set before the child starts (a bad spec: one line here)
+    # the file is read and summed up in a child with the limits of every child (time, memory)
+    summary, check, library = run_limited(lambda: _summarize(path, source, torques, samples, seed), str(path),
+                                          "summarising it")
     if library is not None:  # macros for an entry file to include: nothing to summarise here
         from ar3cli.info.presentation import library_report
 
         finish(library_report(path, library), format)
-    summary = summarize(model, zero_frames)
-    check = None
-    if torques:
-        from ar3cli.info.torques import gravity_torques
-
-        check = gravity_torques(model, samples, seed)
     if png is not None:
         from ar3cli.info.tree_png import tree_png
         from ar3cli.infra.atomic import atomic_write
@@ -80,6 +69,25 @@ def info(
         atomic_write(png, tree_png(summary))
     finish(report(summary, tree=format == "text", torques=check,
                   picture=None if png is None else str(png)), format)
+
+
+def _summarize(path: Path, source: RobotSource, torques: bool, samples: int, seed: int):
+    """(the summary, the torque check or None, None) of the robot file, as ``info`` shows them; for a
+    xacro library (:mod:`ar3cli.urdf.macro_library`), which makes no robot: (None, None, the library)."""
+    from ar3cli.info.summary import summarize
+    from ar3cli.kinematics.fk import urdf_link_frames
+    from ar3cli.urdf.macro_library import macro_library
+
+    model = source.load(path)
+    library = macro_library(model)
+    if library is not None:
+        return None, None, library
+    summary = summarize(model, lambda model: {link: frames[0] for link, frames in urdf_link_frames(model, {}, 1).items()})
+    if not torques:
+        return summary, None, None
+    from ar3cli.info.torques import gravity_torques
+
+    return summary, gravity_torques(model, samples, seed), None
 
 
 def _check_png(png: Path, follow_symlinks: bool) -> Path:

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import enum
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import Annotated, Any, Optional
 
 import typer
 
@@ -54,6 +54,10 @@ EngineOption = Annotated[Engine, typer.Option(
                      "unreadable meshes, contacts at home, 1 s under gravity; needs pip install 'ar3cli[mujoco]'), "
                      "or all; mujoco and all imply --sim.", rich_help_panel=SIM_PANEL)]
 NoConfigOption = Annotated[bool, typer.Option("--no-config", help="Ignore \\[tool.ar3cli.lint] in pyproject.toml.")]
+IsolatedOption = Annotated[bool, typer.Option(
+    "--isolated", help="Judge the files by the command line alone: ignore \\[tool.ar3cli.lint] in pyproject.toml "
+                       "and the files' own suppression comments (ar3cli: ignore, ar3cli: ignore-file); a baseline only "
+                       "when --baseline names one. For pull requests whose author may have written those.")]
 JobsOption = Annotated[Optional[int], typer.Option(
     "--jobs", "-j", min=1, show_default=False,
     help="Processes that share the files, at most one per CPU. Default on Linux: one per 24 files or per 256 KB "
@@ -94,6 +98,24 @@ TargetOption = Annotated[Optional[list[str]], typer.Option(
     "--target", metavar="ENGINES",
     help="Engines the robot is meant for (comma-separated or repeated: pybullet, ros, mujoco, isaac, drake, "
          "gazebo): adds each one's known traps (T rules). Default: pybullet,ros.", show_default=False)]
+
+
+def linter_options(config: Any, select: list[str] | None = None, ignore: list[str] | None = None,
+                   isolated: bool = False, **settings: Any) -> Any:
+    """The linter's :class:`~ar3cli.lint.engine.LintOptions` for the command line's ``--select`` and
+    ``--ignore`` (their CODES strings, comma-separated) and the project's ``config``
+    (:meth:`LintOptions.configured <ar3cli.lint.engine.LintOptions.configured>`)."""
+    from ar3cli.lint.engine import LintOptions
+
+    return LintOptions.configured(config, split_codes(select) if select else None, split_codes(ignore),
+                                  isolated, **settings)
+
+
+def skipped_links_note(skipped: list[str]) -> str:
+    """The note for the symbolic links a folder's search left out (they lead out of the folder)."""
+    shown = ", ".join(skipped[:3]) + (f" and {len(skipped) - 3} more" if len(skipped) > 3 else "")
+    return (f"ar3cli: note: skipped {len(skipped)} symbolic link{'s' if len(skipped) != 1 else ''} to a file outside "
+            f"the folder searched ({shown}); name a file as PATH to lint it")
 
 
 def split_codes(items: list[str] | None) -> list[str]:

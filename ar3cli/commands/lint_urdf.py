@@ -18,6 +18,7 @@ from ar3cli.commands.lint_options import (
     FixHintOption,
     GroupOption,
     IgnoreOption,
+    IsolatedOption,
     JobsOption,
     LintFormatOption,
     NoCacheOption,
@@ -29,8 +30,9 @@ from ar3cli.commands.lint_options import (
     TargetOption,
     WideOption,
     WriteBaselineOption,
+    linter_options,
     parse_targets,
-    split_codes,
+    skipped_links_note,
     srdf_disabled,
 )
 from ar3cli.commands.options import (
@@ -58,6 +60,7 @@ def lint_urdf(
     sim: SimOption = False,
     engine: EngineOption = Engine.pybullet,
     no_config: NoConfigOption = False,
+    isolated: IsolatedOption = False,
     jobs: JobsOption = None,
     no_cache: NoCacheOption = False,
     fix_hint: FixHintOption = False,
@@ -93,8 +96,7 @@ def lint_urdf(
     from ar3cli.commands.lint_report import exit_code, lint_report
     from ar3cli.findings import Severity
     from ar3cli.lint.config import LintConfig, load_config
-    from ar3cli.lint.engine import LintOptions, lint_paths, summarize
-    from ar3cli.lint.rules import validate_patterns
+    from ar3cli.lint.engine import lint_paths, summarize
     from ar3cli.urdf.loading import apply_xacro_options
     from ar3cli.urdf.packages import parse_package_paths
     from ar3cli.urdf.xacro_args import parse_xacro_args
@@ -109,16 +111,14 @@ def lint_urdf(
         from ar3cli.sim.mujoco_session import import_mujoco
 
         import_mujoco()  # a missing extra: one line naming it, exit 2
-    config = LintConfig() if no_config else load_config()
+    config = LintConfig() if no_config or isolated else load_config()
     try:
-        options = LintOptions(
-            select=(validate_patterns(split_codes(select), "--select") if select else config.select) or ["ALL"],
-            ignore=[*config.ignore, *validate_patterns(split_codes(ignore), "--ignore")],
-            per_file_ignores=config.per_file_ignores, severity=config.severity, sim=sim,
-            package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg),
-            srdf_disabled=srdf_disabled(srdf, sim), engines=engines, targets=parse_targets(target))
+        package_paths, xacro_args = parse_package_paths(package_path), parse_xacro_args(xacro_arg)
     except ValueError as exc:
         raise UserError(str(exc)) from None
+    options = linter_options(config, select, ignore, isolated, sim=sim, package_paths=package_paths,
+                             xacro_args=xacro_args, srdf_disabled=srdf_disabled(srdf, sim), engines=engines,
+                             targets=parse_targets(target), sources=str(getattr(format, "value", format)) == "html")
     apply_xacro_options(xacro is XacroMode.trusted, xacro_env)
     threshold = Severity(fail_on.value) if fail_on else (config.fail_on or Severity.ERROR)
     accepted = None
@@ -134,8 +134,13 @@ def lint_urdf(
         results = lint_paths(selection.files, options, use_cache=not no_cache, jobs=jobs) if selection.files else []
         no_files = not selection.candidates
     else:
-        results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs)
+        skipped: list[str] = []
+        results = lint_paths(paths, options, use_cache=not no_cache, jobs=jobs, skipped=skipped)
         no_files = not results
+        if skipped:
+            from ar3cli.output.report import log
+
+            log(skipped_links_note(skipped))
     if no_files:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in paths)}")
     if write_baseline is not None:
@@ -145,8 +150,9 @@ def lint_urdf(
         from ar3cli.lint.baseline import apply_baseline
 
         results, baselined, unused = apply_baseline(results, accepted)
-        held = {"baselined": baselined, "baseline_unused": unused}
-    summary = {**summarize(results, threshold), **(held or {})}
+        held = {"baselined": baselined, "baseline_unused": unused, "baseline": str(baseline)}
+    summary = {**summarize(results, threshold), **(held or {}), "config_file": options.config_file,
+               "isolated": isolated}
     summary["exit_code"] = exit_code(summary, exit_zero)
     fixes = None
     if fix_hint:

@@ -135,8 +135,8 @@ def _apply_timeout(seconds: float) -> float:
 TimeoutOption = Annotated[float, typer.Option(
     "--timeout", metavar="SECONDS", click_type=finite_float(min=0), callback=_apply_timeout,
     rich_help_panel=SHARED_PANEL,
-    help="Wall-clock limit per file for the process that runs pybullet (or a decomposition) on it: one that "
-         "takes longer is stopped, and the file gets a one-line error. 0: no limit. Each such process may also "
-         "map at most half of the memory (1-4 GB; AR3CLI_CHILD_MEMORY_MB sets it).")]
+    help="Wall-clock limit per file for each process that works on it (its checks, pybullet, a decomposition, "
+         "a diff): one that takes longer is stopped, and the file gets a one-line error. 0: no limit. Each such "
+         "process may also map at most half of the memory (1-4 GB; AR3CLI_CHILD_MEMORY_MB sets it).")]
 """``--timeout``: commands give the default (:data:`~ar3cli.infra.child_limits.DEFAULT_TIMEOUT_S`, or
 :data:`~ar3cli.infra.child_limits.LONG_TIMEOUT_S` for sample-collisions and fix-collision)."""

@@ -69,7 +69,7 @@ def report(
     settings = AnalysisSettings(packages=packages, xacro_args=xacro_args, config=load_config(),
                                 targets=parse_targets(target) if target else None, samples=samples, seed=seed)
     made = robot_report(RobotAnalysis.load(path, settings))
-    document = robot_page(made.data, {"lines": made.lines, **finding_context(made.findings)},
+    document = robot_page(made.data, {"lines": made.lines, **finding_context(made.findings, made.sources)},
                           made.pictures).encode("utf-8")
     atomic_write(output, document)
     summary, skipped, verdict = made.data["lint"]["summary"], made.data["skipped"], made.data["verdict"]

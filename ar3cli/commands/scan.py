@@ -81,7 +81,13 @@ def scan(
                               package_paths=parse_package_paths(package_path), xacro_args=parse_xacro_args(xacro_arg))
     except ValueError as exc:
         raise UserError(str(exc)) from None
-    files = collect_files(roots)
+    skipped: list[str] = []
+    files = collect_files(roots, skipped)
+    if skipped:
+        from ar3cli.commands.lint_options import skipped_links_note
+        from ar3cli.output.report import log
+
+        log(skipped_links_note(skipped))
     if not files:
         raise UserError(f"no .urdf or .xacro files found in {', '.join(str(p) for p in roots)}")
     settings = ScanSettings(functools.partial(lint_for_scan, options=options), settings_key(options),

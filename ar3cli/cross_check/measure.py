@@ -19,6 +19,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from ar3cli.errors import UserError
 from ar3cli.findings import listed
 from ar3cli.urdf.model import Model
 
@@ -123,8 +124,11 @@ def _pybullet(model: Model, samples: int, seed: int) -> tuple[Plan, EngineData]:
             data.com.append(_pybullet_com(body))
             if plan.joints and not multi:
                 with capture_fds() as captured:  # Bullet's inverse dynamics prints warnings from C (romeo: axes)
-                    matrix = p.calculateMassMatrix(body.id, q, physicsClientId=client)
-                    torques = p.calculateInverseDynamics(body.id, q, zeros, zeros, physicsClientId=client)
+                    try:
+                        matrix = p.calculateMassMatrix(body.id, q, physicsClientId=client)
+                        torques = p.calculateInverseDynamics(body.id, q, zeros, zeros, physicsClientId=client)
+                    except (p.error, SystemError) as exc:  # SystemError: its C code on absurd masses (1e30 kg)
+                        raise UserError(f"{model.path}: pybullet's mass matrix failed ({exc})") from None
                 data.mass_matrix.append([list(row) for row in matrix])
                 data.gravity.append(list(torques))
                 for message in captured.messages:

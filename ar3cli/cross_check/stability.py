@@ -14,6 +14,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from ar3cli.errors import UserError
 from ar3cli.urdf.model import Model
 
 SECONDS = 1.0
@@ -65,7 +66,10 @@ def _pybullet_drop(model: Model, step: float) -> dict[str, Any]:
             if not joints:
                 return potential
             q, qd = [s[0] for s in joints], np.array([s[1] for s in joints])
-            matrix = np.array(p.calculateMassMatrix(body.id, q, physicsClientId=client))
+            try:
+                matrix = np.array(p.calculateMassMatrix(body.id, q, physicsClientId=client))
+            except (p.error, SystemError) as exc:  # SystemError: its C code on absurd masses (1e30 kg)
+                raise UserError(f"{model.path}: pybullet's mass matrix failed ({exc})") from None
             return potential + 0.5 * float(qd @ matrix @ qd)
 
         frames = body.link_frames()

@@ -15,6 +15,7 @@ verifies the written file (``--verify``), and renders one table or one JSON docu
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 from collections.abc import Callable
 from contextlib import AbstractContextManager, nullcontext
@@ -255,8 +256,11 @@ def run_fixer(fixer: Fixer[Options], options: Options, args: FixerArgs, verify: 
             _check_parses(path, new)
         if args.diff and result.changed:
             result.diff = unified_diff(path, model.source_bytes, new)
-        if result.changed:
-            result.remaining = remaining_findings(path, new, packages, xacro_args)
+        if result.changed:  # a full lint of the result: in a child with the limits of every child
+            from ar3cli.infra.isolation import run_limited
+
+            result.remaining = run_limited(functools.partial(remaining_findings, path, new, packages, xacro_args),
+                                           str(path), "linting the fixed file")
         planned.append((result, new, model))
     writing = args.writes
     if writing:

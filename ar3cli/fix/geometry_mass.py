@@ -51,7 +51,16 @@ def _fmt(value: float) -> str:
 
 
 def shape_mass(shape: Shape, cache: dict | None = None) -> tuple[mp.MassProperties, str]:
-    """Unit-density mass properties of one shape in the link frame, and where they came from."""
+    """Unit-density mass properties of one shape in the link frame, and where they came from; a
+    shape whose numbers overflow or vanish in the arithmetic (a radius of 1e200 or 1e-320) is a
+    :class:`GeometryError` like any other unusable shape."""
+    try:
+        return _shape_mass(shape, cache)
+    except (ArithmeticError, ValueError) as exc:
+        raise GeometryError(f"{shape.geometry.kind or 'geometry'} cannot be measured ({exc})") from None
+
+
+def _shape_mass(shape: Shape, cache: dict | None) -> tuple[mp.MassProperties, str]:
     geometry = shape.geometry
     params = geometry.params
     kind = geometry.kind
@@ -98,7 +107,7 @@ def mesh_mass(shape: Shape, cache: dict) -> tuple[mp.MassProperties, str]:
     if resolution is None or not resolution.found:
         raise GeometryError(f"mesh {geometry.filename!r} not found" + (f" ({resolution.explain()})" if resolution else ""))
     scale = geometry.params.get("scale")
-    if scale is None:
+    if scale is None or not all(math.isfinite(value) and value != 0 for value in scale):
         raise GeometryError(f"mesh {geometry.filename!r} has a malformed scale")
     unit = mesh_unit(geometry)
     if unit is None:
@@ -154,7 +163,10 @@ def _mesh_mass_uncached(path: Path, scale: tuple[float, float, float],
         props = _trimesh_props(mesh)
         kind = "watertight" if watertight else "closed (some edges shared by more than 2 faces)"
         return props, f"mesh {path.name}{scale_note} {kind}, exact"
-    hull = mesh.convex_hull
+    try:
+        hull = mesh.convex_hull
+    except Exception as exc:  # noqa: BLE001 - qhull raises its own types (a flat or degenerate mesh)
+        raise GeometryError(f"mesh {path.name}{scale_note}: no convex hull ({type(exc).__name__})") from None
     mesh_volume = abs(float(mesh.volume))
     ratio = hull.volume / mesh_volume if mesh_volume > 0 else float("inf")
     props = _trimesh_props(hull)

@@ -145,8 +145,12 @@ class Summary:
 
     @property
     def total_mass(self) -> float:
-        """Sum of the ``<mass>`` values; links without one count 0."""
-        return math.fsum(link.mass for link in self.links if link.mass is not None)
+        """Sum of the ``<mass>`` values; links without one count 0; inf past the largest float (masses of 1e308 kg)."""
+        masses = [link.mass for link in self.links if link.mass is not None]
+        try:
+            return math.fsum(masses)
+        except OverflowError:  # fsum raises where a plain sum would give inf
+            return math.inf
 
     def pybullet_mass(self, fixed_base: bool) -> float:
         """The total mass PyBullet simulates: each link without ``<inertial>`` weighs
@@ -177,8 +181,9 @@ class Summary:
             "path": str(self.path), "name": self.name, "root_links": self.roots,
             "link_count": len(self.links), "joint_count": len(self.joints), "dof": self.dof,
             "movable_joint_count": len(self.movable_joints),
-            "total_mass_kg": self.total_mass,
-            "pybullet_mass_kg": {"floating": self.pybullet_mass(False), "fixed_base": self.pybullet_mass(True)},
+            "total_mass_kg": _finite(self.total_mass),
+            "pybullet_mass_kg": {"floating": _finite(self.pybullet_mass(False)),
+                                 "fixed_base": _finite(self.pybullet_mass(True))},
             "links_without_mass": [{"link": link.name, "why": link.mass_note} for link in self.massless_links],
             "centre_of_mass_m": _finite_list(self.centre_of_mass),
             "bounding_box_m": self.bounding_box.to_dict() if self.bounding_box else None,

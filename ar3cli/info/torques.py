@@ -182,7 +182,7 @@ def _compute(model: Model, samples: int, seed: int) -> _Needed:
                 try:
                     tau = p.calculateInverseDynamics(body.id, [float(v) for v in q], zeros, zeros,
                                                      physicsClientId=client)
-                except p.error as exc:
+                except (p.error, SystemError) as exc:  # SystemError: pybullet's C code on absurd masses (1e30 kg)
                     raise UserError(f"{model.path}: pybullet's inverse dynamics failed ({exc})") from None
                 torques[k] = tau
         magnitude = np.abs(torques)

@@ -33,6 +33,7 @@ import time
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.infra.safe_read import kind_of
 
 TEMP_MARKER = ".ar3cli-tmp-"
 """Part of every temporary file name written by :func:`atomic_write`."""
@@ -64,7 +65,13 @@ def check_writable(path: Path, follow_symlinks: bool = False) -> Path:
     check them all first, so a run writes all or nothing.
     """
     path = Path(path)
-    if path.is_symlink():
+    try:
+        is_link = stat.S_ISLNK(os.lstat(path).st_mode)
+    except FileNotFoundError:
+        is_link = False
+    except OSError as exc:  # ENAMETOOLONG, ELOOP, EACCES on a folder above: one line, not a traceback
+        raise UserError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    if is_link:
         target = os.path.realpath(path)
         if not follow_symlinks:
             raise UserError(f"{path}: is a symbolic link (to {target}); refusing to write through it: "
@@ -72,15 +79,22 @@ def check_writable(path: Path, follow_symlinks: bool = False) -> Path:
         path = Path(target)
     else:
         path = Path(os.path.join(os.path.realpath(path.parent), path.name))
-    if path.is_dir():
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        mode = None
+    except OSError as exc:
+        raise UserError(f"{path}: cannot write: {exc.strerror or exc}") from None
+    if mode is not None and stat.S_ISDIR(mode):
         raise UserError(f"{path}: is a directory; give a file name")
+    if mode is not None and not stat.S_ISREG(mode):
+        raise UserError(f"{path}: exists and is not a regular file ({kind_of(mode)}); refusing to replace it: "
+                        "give the name of a file")
     if not path.parent.is_dir():
         raise UserError(f"{path}: folder {path.parent} does not exist")
-    if path.exists():
-        mode = path.stat().st_mode
-        if not os.access(path, os.W_OK) or not mode & 0o222:
-            # a rename would replace it anyway (it needs only a writable folder): respect the intent
-            raise UserError(f"{path}: is read-only for you; make it writable first (chmod u+w) if it should change")
+    if mode is not None and (not os.access(path, os.W_OK) or not mode & 0o222):
+        # a rename would replace it anyway (it needs only a writable folder): respect the intent
+        raise UserError(f"{path}: is read-only for you; make it writable first (chmod u+w) if it should change")
     return path
 
 

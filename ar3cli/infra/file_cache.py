@@ -3,7 +3,9 @@
 A pre-commit hook or a CI step lints the same meshes again and again; reading 50 MB of OBJ and
 STL text takes longer than all the rules together. Facts are keyed by the file's absolute path
 (not resolved through symlinks: realpath costs more than the lookup it serves), modification and
-status-change times (ns) and size, so an edited mesh is read again. Each kind of fact is a folder
+status-change times (ns) and size, so an edited mesh is read again; within a process also by the
+file's identity (device and inode, :func:`identity`), so a file reached by many paths is read once
+(120 paths to one 20 MB OBJ through two links to ``.`` were 120 reads). Each kind of fact is a folder
 of :data:`SHARDS` JSON files, a folder's facts all in one (a run reads only the ones it needs),
 written atomically at exit and only when something new was learnt, merged under a lock with what
 other ar3cli processes saved meanwhile (pre-commit runs several at once); a corrupt or unreadable
@@ -43,6 +45,12 @@ def path_state(path: str) -> PathState | None:
     except (OSError, ValueError):
         return None
     return status.st_mtime_ns, status.st_ctime_ns, status.st_size, status.st_mode
+
+
+def identity(status: os.stat_result) -> tuple[int, ...]:
+    """A file version's identity, whatever path names it: device, inode, size, modification and
+    status-change times (ns). Two paths with the same identity are the same bytes."""
+    return status.st_dev, status.st_ino, status.st_size, status.st_mtime_ns, status.st_ctime_ns
 
 
 _OPEN: dict[str, FileFacts] = {}
@@ -119,6 +127,8 @@ class FileFacts:
         self._learned: dict[str, dict[str, Any]] = {}
         """Entries stored since :func:`take_learned` last asked (a worker's answer to its parent)."""
         self._saving = False
+        self._by_identity: dict[tuple[int, ...], Any] = {}
+        """This process's facts by file identity, whatever path reached the file."""
         _OPEN[name] = self
 
     @staticmethod
@@ -137,13 +147,21 @@ class FileFacts:
         return entries
 
     def get(self, path: Path, status: os.stat_result) -> Any:
-        """The stored fact for this version of ``path``, or :data:`MISSING`."""
+        """The stored fact for this version of ``path``, or :data:`MISSING`. Within a process, a
+        file reached by several paths (``a/m.obj``, ``a/b/a/m.obj`` through links to ``.``) is one
+        file: the fact learnt through one path answers for all (:func:`identity`)."""
+        known = self._by_identity.get(identity(status), MISSING)
+        if known is not MISSING:
+            return known
         absolute, shard = _placed(os.fspath(path))
         return self._load(shard).get(self._key(absolute, status), MISSING)
 
     def put(self, path: Path, status: os.stat_result, value: Any) -> None:
         """Remember ``value`` (JSON-serialisable) for this version of ``path``; saved at exit."""
         absolute, _ = _placed(os.fspath(path))
+        if len(self._by_identity) >= self.max_entries:
+            self._by_identity.clear()
+        self._by_identity[identity(status)] = value
         self.store(self._key(absolute, status), value, near=path)
 
     def lookup(self, key: str, near: str | os.PathLike[str] | None = None) -> Any:

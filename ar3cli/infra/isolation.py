@@ -57,7 +57,7 @@ def announce_slow_work(say: Callable[[str], None] | None) -> None:
     _announce = say
 
 
-def _slow_note(subject: str) -> Callable[[list[bytes]], None] | None:
+def _slow_note(subject: str, stage: str = DEFAULT_STAGE) -> Callable[[list[bytes]], None] | None:
     """The ``tick`` of :func:`~ar3cli.infra.outcome.read_until` that announces slow work, or None."""
     if _announce is None:
         return None
@@ -71,7 +71,7 @@ def _slow_note(subject: str) -> Callable[[list[bytes]], None] | None:
         now = time.monotonic()
         if now >= due[0]:
             due[0] = now + SLOW_EVERY_S
-            say(f"{subject}: still {_messages(b''.join(chunks))[1]} ({now - started:.0f} s)")
+            say(f"{subject}: still {_messages(b''.join(chunks), stage)[1]} ({now - started:.0f} s)")
 
     return tick
 
@@ -99,8 +99,17 @@ def report_stage(stage: str) -> None:
         _send(_stage_pipe, ("stage", stage))
 
 
+def run_limited(work: Callable[[], Result], subject: str, stage: str) -> Result:
+    """``work()`` (ar3cli's own work on an untrusted file: a diff, a summary, a fix's plan) in a forked
+    child with the limits of every child: the command's ``--timeout`` and the memory cap. A file
+    built to take hours or gigabytes is then one line (``robot.urdf: timed out after 120 s while
+    comparing it; ...``), never a run that stalls or is killed. ``stage`` says what the work does."""
+    return run_isolated(work, subject, library="ar3cli", stage=stage)
+
+
 def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], str | None] | None = None,
-                 timeout: float | None = None, meanwhile: Callable[[], None] | None = None) -> Result:
+                 timeout: float | None = None, meanwhile: Callable[[], None] | None = None,
+                 library: str = "pybullet", stage: str = DEFAULT_STAGE) -> Result:
     """``work()`` in a forked child; its result (which must pickle) or its exception comes back.
 
     A UserError in the child is raised here as it was; any other exception becomes a RuntimeError
@@ -132,15 +141,15 @@ def run_isolated(work: Callable[[], Result], subject: str, cause: Callable[[], s
         if meanwhile is not None:
             meanwhile()
         data, finished = read_until(child[1].fileno(), None if seconds is None else time.monotonic() + seconds,
-                                    _slow_note(subject))
-        answer, stage = _messages(data)
+                                    _slow_note(subject, stage))
+        answer, stage = _messages(data, stage)
         if not finished:
             raise ChildTimeoutError(f"{subject}: timed out after {seconds:g} s while {stage}; raise --timeout "
                                     "(0: no limit) if the file is just large", "timeout", stage)
         child[1].close()
         status = _reap(child[0])
         child = None
-        return _unpack(answer, stage, status, subject, cause)
+        return _unpack(answer, stage, status, subject, cause, library)
     except KeyboardInterrupt as exc:
         settle = shutdown.settle_after(exc)
         raise
@@ -198,9 +207,10 @@ def _send(pipe: BinaryIO, message: tuple) -> None:
     pipe.flush()
 
 
-def _messages(data: bytes) -> tuple[tuple | None, str]:
-    """The child's messages, read to the end: (its final answer or None, the last stage it named)."""
-    stage, answer = DEFAULT_STAGE, None
+def _messages(data: bytes, stage: str = DEFAULT_STAGE) -> tuple[tuple | None, str]:
+    """The child's messages, read to the end: (its final answer or None, the last stage it named,
+    else ``stage``)."""
+    answer = None
     stream = io.BytesIO(data)
     while True:
         try:
@@ -226,7 +236,7 @@ def _reap(pid: int) -> int:
 
 
 def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
-            cause: Callable[[], str | None] | None) -> Result:
+            cause: Callable[[], str | None] | None, library: str = "pybullet") -> Result:
     if answer is not None:
         try:
             return unwrap(answer)
@@ -245,8 +255,8 @@ def _unpack(answer: tuple | None, stage: str, status: int, subject: str,
         explanation = f"; {reason}"
     elif name == "SIGABRT" and child_limits.memory_limit() is not None:  # how C++ ends when memory runs out
         explanation = (f": it ran out of memory (the limit of a child process is {child_limits.describe_memory_limit()}; "
-                       f"set {child_limits.MEMORY_VARIABLE} to change it), or a bug in pybullet's C code that this "
+                       f"set {child_limits.MEMORY_VARIABLE} to change it), or a bug in {library}'s C code that this "
                        f"file triggers (see 'ar3cli lint-urdf {subject}')")
     else:
-        explanation = f": a bug in pybullet's C code that this file triggers (see 'ar3cli lint-urdf {subject}')"
-    raise CrashError(f"{subject}: pybullet crashed ({name}) while {stage}{explanation}", name, stage)
+        explanation = f": a bug in {library}'s C code that this file triggers (see 'ar3cli lint-urdf {subject}')"
+    raise CrashError(f"{subject}: {library} crashed ({name}) while {stage}{explanation}", name, stage)

@@ -22,6 +22,20 @@ ROBOT_FILE = "a .urdf or .xacro file"
 """What :func:`read_bytes` expects unless told otherwise (the wording of its messages)."""
 
 
+def kind_of(mode: int) -> str:
+    """What a file that is not a regular file is, for a message: "a FIFO", "a device", "a socket",
+    "a folder" (from its ``st_mode``)."""
+    if stat.S_ISFIFO(mode):
+        return "a FIFO"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "a device"
+    if stat.S_ISSOCK(mode):
+        return "a socket"
+    if stat.S_ISDIR(mode):
+        return "a folder"
+    return "not a regular file"
+
+
 def read_bytes(path: Path, *, limit: int | None = None, what: str = ROBOT_FILE) -> bytes:
     """Return the file's bytes, or raise a one-line :class:`UserError` saying why not.
 

@@ -30,7 +30,7 @@ from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.findings import Finding
-from ar3cli.lint.engine import LintResult, message_shape
+from ar3cli.lint.engine import LintResult, Suppressed, message_shape
 
 VERSION = 1
 _QUOTED = re.compile(r"""'([^']*)'|"([^"]*)\"""")
@@ -119,8 +119,9 @@ def read_baseline(path: Path) -> Baseline:
 
 
 def apply_baseline(results: list[LintResult], baseline: Baseline) -> tuple[list[LintResult], int, int]:
-    """``results`` without the findings the baseline accepts; also how many were dropped and how
-    many baseline entries of the files linted in this run were not used (fixed since)."""
+    """``results`` without the findings the baseline accepts (kept among each result's suppressed
+    ones, by ``baseline``); also how many were dropped and how many baseline entries of the files
+    linted in this run were not used (fixed since)."""
     left = Counter(baseline.entries)
     keys: dict[str, str] = {}
     kept_results = []
@@ -128,7 +129,7 @@ def apply_baseline(results: list[LintResult], baseline: Baseline) -> tuple[list[
     seen: set[str] = set()
     for result in results:
         seen.add(keys.setdefault(result.path, baseline_key(result.path, baseline.folder)))
-        kept = []
+        kept, held = [], list(result.suppressed)
         for finding in result.findings:
             file = keys.setdefault(finding.path, baseline_key(finding.path, baseline.folder))
             seen.add(file)
@@ -136,8 +137,9 @@ def apply_baseline(results: list[LintResult], baseline: Baseline) -> tuple[list[
             if left[key] > 0:
                 left[key] -= 1
                 dropped += 1
+                held.append(Suppressed(finding, "baseline"))
             else:
                 kept.append(finding)
-        kept_results.append(dataclasses.replace(result, findings=kept))
+        kept_results.append(dataclasses.replace(result, findings=kept, suppressed=held))
     unused = sum(count for (file, _, _), count in left.items() if file in seen and count > 0)
     return kept_results, dropped, unused

@@ -15,11 +15,14 @@ def exit_code(summary: dict[str, Any], exit_zero: bool = False) -> int:
 
 
 def lint_json(results: list, summary: dict[str, Any]) -> dict[str, Any]:
-    """``{"files", "findings" (each with the command that fixes it, ``fixed_by``), "summary"}`` of
+    """``{"files", "findings" (each with the command that fixes it, ``fixed_by``), "summary",
+    "suppressed" (each finding not reported, with what suppressed it: ``suppressed_by``)}`` of
     ``results`` (:class:`~ar3cli.lint.engine.LintResult`) and their ``summary``."""
     from ar3cli.lint.fix_hints import fixed_by
 
     findings = [finding for result in results for finding in result.findings]
     return {"files": [result.to_dict() for result in results],
             "findings": [{**finding.to_dict(), "fixed_by": fixed_by(finding.rule)} for finding in findings],
-            "summary": summary}
+            "summary": summary,
+            "suppressed": [{**item.finding.to_dict(), "suppressed_by": item.by}
+                           for result in results for item in result.suppressed]}

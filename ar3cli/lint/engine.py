@@ -10,8 +10,10 @@ open a :class:`~ar3cli.sim.session.Session` lazily through :attr:`Context.sessio
 
 from __future__ import annotations
 
+import dataclasses
 import fnmatch
 import functools
+import hashlib
 import os
 import re
 from collections import Counter
@@ -55,11 +57,49 @@ class LintOptions:
     """Simulators ``--sim`` runs (``--engine``): P rules need ``pybullet``, M rules ``mujoco`` (or their code named)."""
     targets: tuple[str, ...] = ("pybullet", "ros")
     """Engines the robot is meant for (``--target``): their T rules run."""
+    config_select: list[str] | None = None
+    """``[tool.ar3cli.lint] select`` when the command line gave no ``--select``: the findings of
+    other rules are suppressed by the configuration (counted and said, never silently dropped)."""
+    config_ignore: list[str] = field(default_factory=list)
+    """``[tool.ar3cli.lint] ignore``: the findings of these rules are suppressed by the configuration."""
+    config_file: str | None = None
+    """The pyproject.toml the configuration came from, as the summary names it."""
+    in_file: bool = True
+    """Honour the files' own suppression comments (``ar3cli: ignore``, ``ar3cli: ignore-file``);
+    ``--isolated`` turns it off."""
+    sources: bool = False
+    """Record which files' lines a page may show, with the digest of the bytes parsed
+    (:attr:`LintResult.sources`): for ``--format html`` and ``report``."""
+
+    @classmethod
+    def configured(cls, config: Any, select: list[str] | None = None, ignore: list[str] | None = None,
+                   isolated: bool = False, **settings: Any) -> LintOptions:
+        """The options for the project's ``config`` (a :class:`~ar3cli.lint.config.LintConfig`) and
+        the command line's ``select`` and ``ignore`` codes (None: none given); ``settings`` are the
+        other fields. Every front-end builds them here (lint-urdf, report, view, server), so they agree.
+
+        What the command line selects is what runs; the configuration's select, ignore and
+        per-file-ignores only suppress findings afterwards (:func:`settle`: counted, and said in
+        every format), its severity table re-grades them. ``isolated`` (``--isolated``) also reports
+        what the files' own comments suppress. A malformed code is a UserError."""
+        from ar3cli.lint.rules import validate_patterns
+
+        try:
+            chosen = validate_patterns(select, "--select") if select else None
+            return cls(select=chosen or ["ALL"], ignore=validate_patterns(ignore or [], "--ignore"),
+                       config_select=None if chosen else config.select, config_ignore=list(config.ignore),
+                       per_file_ignores=dict(config.per_file_ignores), severity=dict(config.severity),
+                       config_file=str(config.path) if config.path is not None else None,
+                       in_file=not isolated, **settings)
+        except ValueError as exc:
+            raise UserError(str(exc)) from None
 
     def rules(self) -> list[Rule]:
         """Selected rules in registry order; simulation rules only with ``sim``; opt-in rules only
-        when ``select`` names their code; target rules only for the ``targets`` (or when named)."""
-        named = {code.upper() for code in self.select}
+        when ``select`` (or the configuration's) names their code; target rules only for the
+        ``targets`` (or when named). The configuration's select and ignore do not narrow this: their
+        rules run and their findings are suppressed by :func:`settle`, so the run can say so."""
+        named = {code.upper() for code in (*self.select, *(self.config_select or []))}
         return [r for r in RULES if matches(r.code, self.select) and not matches(r.code, self.ignore)
                 and (self.sim or not r.needs_sim) and (not r.opt_in or r.code in named)
                 and (not r.needs_sim or ENGINE_OF.get(r.code[0]) in self.engines or r.code in named)
@@ -77,9 +117,29 @@ class LintResult:
     error: str | None = None
     cached: bool = False
     """Answered from the result cache (said in the text summary; the JSON is the same either way)."""
+    suppressed: list[Suppressed] = field(default_factory=list)
+    """Findings not reported, and by what: the file's comments, the configuration, the baseline."""
+    lowered: int = 0
+    """Findings the configuration's ``severity`` table made less severe than their rule's."""
+    sources: dict[str, str] = field(default_factory=dict)
+    """With :attr:`LintOptions.sources`: display path -> SHA-256 of the bytes ar3cli parsed, for each
+    file whose lines may be shown with a finding (:func:`shown_sources`)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
+
+
+SUPPRESSED_BY = ("config", "comment", "baseline")
+"""What may suppress a finding: ``[tool.ar3cli.lint]`` (select, ignore, per-file-ignores), a comment
+in the file (``ar3cli: ignore``, ``ar3cli: ignore-file``), or ``--baseline``."""
+
+
+@dataclass(frozen=True)
+class Suppressed:
+    """A finding that is not reported, and what suppressed it (one of :data:`SUPPRESSED_BY`)."""
+
+    finding: Finding
+    by: str
 
 
 def display_path(path: Path) -> str:
@@ -93,17 +153,32 @@ def display_path(path: Path) -> str:
     return str(path) if relative.startswith("..") else Path(relative).as_posix()
 
 
-def collect_files(paths: Iterable[Path]) -> list[Path]:
+def collect_files(paths: Iterable[Path], skipped: list[str] | None = None) -> list[Path]:
     """Files to lint: given files as they are, folders searched for ``*.urdf`` / ``*.xacro`` (sorted).
 
+    A folder's search leaves out a symbolic link whose target lies outside that folder
+    (``robot.urdf -> ~/.aws/credentials`` committed in a pull request): its display path goes to
+    ``skipped`` when given. A file named on the command line is linted as asked, link or not.
     A path that does not exist is a usage error (exit 2): it is a typo, not a finding.
     """
     found: list[Path] = []
     for path in paths:
-        if path.is_dir():
+        try:
+            is_dir = path.is_dir()
+        except OSError:  # a name the OS refuses (a component over 255 bytes): the file's F001 says so
+            found.append(path)
+            continue
+        if is_dir:
             for folder, dirs, files in os.walk(path):
                 dirs[:] = sorted(d for d in dirs if d not in _SKIP_DIRS)
-                found += [Path(folder) / name for name in sorted(files) if name.lower().endswith(ROBOT_SUFFIXES)]
+                for name in sorted(files):
+                    if not name.lower().endswith(ROBOT_SUFFIXES):
+                        continue
+                    full = os.path.join(folder, name)  # os.walk enters no linked folder: only the file may lead out
+                    if not os.path.islink(full) or inside_tree(full, path):
+                        found.append(Path(folder) / name)
+                    elif skipped is not None:
+                        skipped.append(display_path(Path(folder) / name))
         elif path.exists() or path.is_symlink():
             found.append(path)
         else:
@@ -113,6 +188,13 @@ def collect_files(paths: Iterable[Path]) -> list[Path]:
         folder, name = os.path.split(path)
         unique.setdefault(os.path.join(os.path.realpath(folder or "."), name), path)
     return list(unique.values())
+
+
+def inside_tree(file: str | os.PathLike[str], tree: str | os.PathLike[str]) -> bool:
+    """True when ``file``, symbolic links resolved, lies in the folder ``tree`` (links resolved too)
+    or below it: what ar3cli may show of a robot file (and what a folder's search takes)."""
+    root = os.path.realpath(tree)
+    return os.path.realpath(file).startswith(root.rstrip(os.sep) + os.sep)
 
 
 FILES_PER_WORKER = 24
@@ -130,31 +212,105 @@ docs/commands/lint-urdf.md."""
 
 
 def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = True,
-               jobs: int | None = None) -> list[LintResult]:
+               jobs: int | None = None, skipped: list[str] | None = None) -> list[LintResult]:
     """Lint every file under ``paths``; one :class:`LintResult` per file, in order.
 
     With ``use_cache``, unchanged files reuse the findings of an earlier run (:mod:`ar3cli.lint.result_cache`).
     ``jobs`` processes share the files (None: one per CPU for large batches, see
-    :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it.
+    :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it. ``skipped``
+    receives the links a folder's search left out (:func:`collect_files`).
     """
-    from ar3cli.infra.process_pool import map_in_processes
+    from ar3cli.infra import process_pool
+    from ar3cli.infra.streaming_pool import stream
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
-    files = collect_files(paths)
+    files = collect_files(paths, skipped)
+    if not process_pool.can_fork():  # Windows, macOS: in this process, without limits
+        return [settle(lint_file(path, rules, options, cache), options) for path in files]
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
-    if workers <= 1:
-        return [lint_file(path, rules, options, cache) for path in files]
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
-    order = balanced_order(sizes, workers)
-    outcomes = map_in_processes(job, [files[index] for index in order], workers, what="a lint worker")
+    largest_first = sorted(range(len(files)), key=lambda index: -sizes[index])
+    limit = file_time_limit(options)
     results: list[LintResult] = [None] * len(files)  # type: ignore[list-item]
-    for index, (result, learned) in zip(order, outcomes):
-        merge_learned(learned)
-        results[index] = result
+    for index, (kind, payload) in stream(lambda index: job(files[index]), largest_first, workers, limit):
+        if kind == "ok":
+            result, learned = payload
+            merge_learned(learned)
+        elif kind == "interrupted":
+            raise KeyboardInterrupt
+        else:
+            result = LintResult(display_path(files[index]), False, [], _stopped(display_path(files[index]), kind,
+                                                                                 payload, limit))
+        results[index] = settle(result, options)
     return results
+
+
+def file_time_limit(options: LintOptions) -> float | None:
+    """Seconds one file's check may take (None: no limit): the command's ``--timeout`` for its
+    static checks, plus as much again for each simulator ``--sim`` runs (each in a child of its own
+    with that limit)."""
+    from ar3cli.infra import child_limits
+
+    seconds = child_limits.timeout()
+    if seconds is None:
+        return None
+    return seconds * (1 + (len(options.engines) if options.sim else 0))
+
+
+def _stopped(shown: str, kind: str, payload: Any, limit: float | None) -> str:
+    """The one line for a file whose check did not come back: it ran past its time, out of memory,
+    its process died, or ar3cli failed on it (a bug)."""
+    from ar3cli.infra.child_limits import MEMORY_VARIABLE, describe_memory_limit
+
+    if kind == "timeout":
+        return (f"{shown}: checking it took longer than the limit of {limit:g} s per file; raise --timeout "
+                "(0: no limit) if the file is just large")
+    if kind == "out-of-memory":
+        return (f"{shown}: checking it ran out of memory (the limit of a child process is {describe_memory_limit()}; "
+                f"set {MEMORY_VARIABLE} to change it)")
+    if kind == "crash":
+        return f"{shown}: the process checking it died: {payload}"
+    if kind == "user-error":
+        return payload[0]
+    return f"{shown}: {internal_error('while checking it', RuntimeError(payload))}"
+
+
+def settle(result: LintResult, options: LintOptions) -> LintResult:
+    """``result`` (as :func:`lint_file` gives it) with the run's settings applied: without
+    ``in_file``, the findings the file's own comments suppressed are reported again; the findings
+    the configuration deselects (its ``select``, ``ignore``, ``per-file-ignores``) move to the
+    suppressed ones, by ``config``; its ``severity`` table is applied (``lowered`` counts the
+    findings it made less severe). A file that could not be loaded reports why whatever the
+    configuration selected: only its ``ignore`` suppresses that."""
+    findings, suppressed = list(result.findings), []
+    for item in result.suppressed:
+        if item.by == "comment" and not options.in_file:
+            findings.append(item.finding)
+        else:
+            suppressed.append(item)
+    if len(findings) != len(result.findings):
+        findings.sort(key=lambda f: (f.path != result.path, f.path, f.line, f.column, f.rule))
+    kept, lowered = [], 0
+    for finding in findings:
+        if _config_suppresses(finding, result, options):
+            suppressed.append(Suppressed(finding, "config"))
+            continue
+        changed = _override(finding, options)
+        lowered += changed.severity < finding.severity
+        kept.append(changed)
+    return dataclasses.replace(result, findings=kept, suppressed=suppressed, lowered=result.lowered + lowered)
+
+
+def _config_suppresses(finding: Finding, result: LintResult, options: LintOptions) -> bool:
+    code = finding.rule
+    if matches(code, options.config_ignore) or _file_ignored(finding.path, code, options):
+        return True
+    if finding.path != result.path and _file_ignored(result.path, code, options):  # an included file's finding
+        return True
+    return options.config_select is not None and result.loaded and not matches(code, options.config_select)
 
 
 def _workers(jobs: int | None, sizes: list[int], sim: bool) -> int:
@@ -171,21 +327,6 @@ def _workers(jobs: int | None, sizes: list[int], sim: bool) -> int:
     return max(by_files, min(len(sizes), worker_count(None, sum(sizes), BYTES_PER_WORKER)))
 
 
-def balanced_order(sizes: list[int], workers: int) -> list[int]:
-    """Indices of the items in the order that gives round-robin dealing to ``workers`` processes
-    (:func:`~ar3cli.infra.process_pool.map_in_processes`: worker ``w`` takes positions ``w``,
-    ``w + workers``, ...) shares of about equal size: largest first, each round of ``workers``
-    dealt in the opposite direction of the one before (a snake draft). A robot's file size
-    follows its link and mesh count; dealt in command-line order, one process got the big robots
-    and the other waited."""
-    by_size = sorted(range(len(sizes)), key=lambda index: -sizes[index])
-    order: list[int] = []
-    for start in range(0, len(by_size), workers):
-        chunk = by_size[start:start + workers]
-        order += chunk if (start // workers) % 2 == 0 else chunk[::-1]
-    return order
-
-
 def _size(path: Path) -> int:
     """The file's size in bytes (0 when it cannot be read: its one-line finding is cheap)."""
     try:
@@ -194,11 +335,23 @@ def _size(path: Path) -> int:
         return 0
 
 
+MAX_FINDINGS_TEXT = 64 * 1024 * 1024
+"""Characters of findings (messages and hints) one file may hand back: a 20,000-link star's findings
+are ~6 MB. More is a file built to flood the output (every finding listing thousands of names):
+the file gets one error line instead, and ar3cli never holds or prints it."""
+
+
 def _lint_file_in_worker(path: Path, rules: list[Rule], options: LintOptions,
                          cache: ResultCache | None) -> tuple[LintResult, dict[str, Any]]:
     """:func:`lint_file`, plus what the on-disk caches learnt meanwhile (a worker never saves them:
-    its parent merges and saves)."""
-    return lint_file(path, rules, options, cache), take_learned()
+    its parent merges and saves); a result over :data:`MAX_FINDINGS_TEXT` stays in the worker."""
+    result = lint_file(path, rules, options, cache)
+    size = sum(len(f.message) + len(f.hint) for f in result.findings)
+    if size > MAX_FINDINGS_TEXT:
+        result = LintResult(result.path, result.loaded, [], f"{result.path}: its {len(result.findings)} findings "
+                            f"hold {size / 1e6:.0f} million characters, more than ar3cli reports for one file "
+                            f"({MAX_FINDINGS_TEXT / 1e6:.0f} million): a file built to flood the output?")
+    return result, take_learned()
 
 
 def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None:
@@ -207,8 +360,7 @@ def _result_cache(options: LintOptions, rules: list[Rule]) -> ResultCache | None
         return None
     from ar3cli.lint.result_cache import ResultCache
 
-    return ResultCache.for_settings(rules=[rule.code for rule in rules], per_file_ignores=options.per_file_ignores,
-                                    severity=options.severity, package_paths=options.package_paths,
+    return ResultCache.for_settings(rules=[rule.code for rule in rules], package_paths=options.package_paths,
                                     xacro_args=options.xacro_args, targets=options.targets)
 
 
@@ -225,27 +377,44 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     if cache is not None and not is_xacro(path):
         remembered = cache.get(path, shown)
         if remembered is not None:
-            return LintResult(shown, True, remembered, cached=True)
+            found, by_comment, digest = remembered
+            sources = {shown: digest} if options.sources and inside_tree(path, os.path.dirname(path) or ".") else {}
+            return LintResult(shown, True, found, cached=True, suppressed=[Suppressed(f, "comment") for f in by_comment],
+                              sources=sources)
+    data = None
     try:
-        model = load_model(path, options.package_paths, options.xacro_args)
+        if options.sources:  # read here, so that what a page may show is exactly what was parsed
+            from ar3cli.infra.safe_read import read_bytes
+
+            data = read_bytes(path)
+        model = load_model(path, options.package_paths, options.xacro_args, source=data)
     except UserError as exc:
-        return unloaded_result(load_failure(path, shown, exc.message), options)
+        finding = load_failure(path, shown, exc.message)
     except RecursionError:
-        return unloaded_result(Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown), options)
-    result = lint_model(model, shown, rules, options)
-    if cache is not None and not model.is_xacro:
-        cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed)
-    return result
+        finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
+    except MemoryError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - the loader's bug: this file's error line, the batch goes on
+        return LintResult(shown, False, [], f"{shown}: {internal_error('while loading it', exc)}")
+    else:
+        result = lint_model(model, shown, rules, options)
+        if cache is not None and not model.is_xacro and result.error is None:
+            cache.put(path, shown, model.source_bytes, result.findings, model.resolver.probed,
+                      [item.finding for item in result.suppressed if item.by == "comment"])
+        return result
+    own = data is not None and inside_tree(path, os.path.dirname(path) or ".")
+    return unloaded_result(finding, options, {shown: hashlib.sha256(data).hexdigest()} if own else {})
 
 
-def unloaded_result(finding: Finding, options: LintOptions) -> LintResult:
-    """The result of a file that did not load, ``finding`` (:func:`load_failure`) saying why.
+def unloaded_result(finding: Finding, options: LintOptions, sources: dict[str, str] | None = None) -> LintResult:
+    """The result of a file that did not load, ``finding`` (:func:`load_failure`) saying why; ``sources``
+    as :attr:`LintResult.sources` (the bytes read, where a page may show them).
 
     A file that cannot be loaded was not checked at all: say so whatever --select picked (as ruff
-    always reports syntax errors); only an explicit ignore hides it."""
-    if matches(finding.rule, options.ignore) or _file_ignored(finding.path, finding.rule, options):
+    always reports syntax errors); only an explicit ignore hides it (the configuration's: :func:`settle`)."""
+    if matches(finding.rule, options.ignore):
         return LintResult(finding.path, False, [])
-    return LintResult(finding.path, False, [_override(finding, options)])
+    return LintResult(finding.path, False, [finding], sources=sources or {})
 
 
 def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
@@ -257,7 +426,7 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
     if not model.links and not model.joints and is_macro_library(model):  # a xacro library: one info line (F008)
         rules = [] if matches(LIBRARY, options.ignore) else [REGISTRY[LIBRARY]]
     static, simulated, in_mujoco = _partition(rules)
-    findings = _run_rules(model, shown, static, options)
+    findings, suppressed, failures = _run_rules(model, shown, static, options)
     error = None
     if simulated or in_mujoco:
         from ar3cli.infra.isolation import CrashError
@@ -268,15 +437,42 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
             if not selected:
                 continue
             try:
-                findings += run(lambda selected=selected: _run_rules(model, shown, selected, options), model)
+                found, held, failed = run(lambda selected=selected: _run_rules(model, shown, selected, options),
+                                          model)
             except CrashError as exc:
                 error = exc.message
+            else:
+                findings += found
+                suppressed += held
+                failures += failed
         if simulated and in_mujoco:
             from ar3cli.lint.rules.mujoco import merge_home_contacts
 
             findings = merge_home_contacts(findings)
+    if failures and error is None:
+        error = f"{shown}: {failures[0]}" + (f" (and {len(failures) - 1} more rules)" if len(failures) > 1 else "")
     findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
-    return LintResult(shown, True, findings, error)
+    return LintResult(shown, True, findings, error, suppressed=suppressed,
+                      sources=shown_sources(model, shown) if options.sources else {})
+
+
+def shown_sources(model, shown: str) -> dict[str, str]:
+    """The files whose lines a page may show with a finding, by display path, each with the SHA-256
+    of the bytes ar3cli parsed: the linted file, unless it is a symbolic link leading out of its own
+    folder (``robot.urdf -> ~/.aws/credentials``: linted as asked, never shown), and for a xacro,
+    each file xacro parsed (read only inside the robot's folder and packages in safe mode). The
+    page re-reads a file and shows it only when its bytes still have that digest."""
+    own = inside_tree(model.path, os.path.dirname(model.path) or ".")
+    sources = {shown: hashlib.sha256(model.source_bytes).hexdigest()} if own else {}
+    if model.is_xacro:
+        from ar3cli.urdf.xacro_expand import parsed_digests
+
+        locator = Locator(model, shown)
+        for name, digest in parsed_digests(model.xml_bytes).items():
+            path = locator.shown_file(name)
+            if path != shown:
+                sources.setdefault(path, digest)
+    return sources
 
 
 def is_macro_library(model) -> bool:
@@ -303,29 +499,49 @@ def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
 _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
 
 
-def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> list[Finding]:
-    """The located, unsuppressed findings of ``rules`` on ``model`` (unsorted)."""
+def _run_rules(model, shown: str, rules: list[Rule],
+               options: LintOptions) -> tuple[list[Finding], list[Suppressed], list[str]]:
+    """The located findings of ``rules`` on ``model`` (unsorted), those the file's own comments
+    suppress, and one line per rule that failed on this file. The configuration is applied later,
+    by :func:`settle` (so the result cache holds what the file alone decides).
+
+    A rule that raises (a value the file holds overflows a computation it did not expect, say) is a
+    bug in that rule: its findings so far are kept, the other rules still run, and the file's error
+    line names it, so one file never ends the batch (:func:`lint_model` makes it the file's error).
+    """
     context = Context(model, options.srdf_disabled, options.targets)
     locator = Locator(model, shown)
-    file_ignores = _file_level_ignores(model.source_bytes)
+    file_ignores = _file_level_ignores(model)
     findings: list[Finding] = []
+    suppressed: list[Suppressed] = []
+    failures: list[str] = []
     try:
         for rule in rules:
             if rule.check is None:
                 continue
-            for hit in rule.check(context):
-                if matches(rule.code, file_ignores) or _file_ignored(shown, rule.code, options):
-                    continue
-                if hit.element is not None and suppressed_inline(hit.element, rule.code):
-                    continue
-                path, line, column = locator.locate(hit)
-                if path != shown and _file_ignored(path, rule.code, options):  # a xacro's included file
-                    continue
-                findings.append(_override(Finding(rule.code, rule.severity_for(options.targets), hit.message, path, line,
-                                                  column, hit.hint or rule.fix), options))
+            try:
+                for hit in rule.check(context):
+                    path, line, column = locator.locate(hit)
+                    finding = Finding(rule.code, rule.severity_for(options.targets), hit.message, path, line, column,
+                                      hit.hint or rule.fix)
+                    if matches(rule.code, file_ignores) or (hit.element is not None
+                                                            and suppressed_inline(hit.element, rule.code)):
+                        suppressed.append(Suppressed(finding, "comment"))
+                    else:
+                        findings.append(finding)
+            except (UserError, MemoryError):
+                raise
+            except Exception as exc:  # noqa: BLE001 - a rule's bug: this file's error line, the batch goes on
+                failures.append(internal_error(f"in rule {rule.code}", exc) + "; the other rules ran")
     finally:
         context.close()
-    return findings
+    return findings, suppressed, failures
+
+
+def internal_error(where: str, exc: BaseException) -> str:
+    """The line that says ar3cli failed on a file ``where`` (``in rule G014``): a bug to report."""
+    text = " ".join(str(exc).split())[:200]
+    return f"internal error {where} ({type(exc).__name__}{': ' + text if text else ''}), please report it"
 
 
 def load_failure(path: Path, shown: str, message: str) -> Finding:
@@ -376,7 +592,7 @@ class Locator:
             while node is not None:
                 origin = origins.get(node)
                 if origin is not None:
-                    return self._file(origin.file), origin.line, origin.column
+                    return self.shown_file(origin.file), origin.line, origin.column
                 node = node.getparent()
         return (self.shown, *self._xacro_position(element))
 
@@ -391,7 +607,7 @@ class Locator:
             self._origins = dict(zip(elements, found)) if len(found) == len(elements) else {}
         return self._origins
 
-    def _file(self, file: str) -> str:
+    def shown_file(self, file: str) -> str:
         """The display path of a file xacro read: the linted file as shown, an included one
         relative to the current directory (``a/../b`` folded when it is the same file)."""
         if file not in self._files:
@@ -442,11 +658,33 @@ def _file_ignored(shown: str, code: str, options: LintOptions) -> bool:
     return False
 
 
-def _file_level_ignores(source: bytes) -> list[str]:
+def _file_level_ignores(model) -> list[str]:
+    """The codes of the ``<!-- ar3cli: ignore-file[...] -->`` comments of the file: only in an XML
+    comment, as documented (the same words in a name or a text were a way to silence a file), and
+    in the file as written (a xacro's source, not its expansion)."""
+    if not _FILE_LEVEL.search(model.source_bytes):
+        return []
     codes: list[str] = []
-    for match in _FILE_LEVEL.finditer(source):
-        codes += _codes(match.group(1).decode("ascii", "replace") if match.group(1) is not None else None)
+    for comment in _comments(model):
+        for match in _FILE_LEVEL.finditer((comment.text or "").encode("utf-8", "surrogateescape")):
+            codes += _codes(match.group(1).decode("ascii", "replace") if match.group(1) is not None else None)
     return codes
+
+
+def _comments(model) -> list[Any]:
+    """Every comment of the file as written, those before and after its root element included."""
+    from lxml import etree
+
+    from ar3cli.urdf import xmlsource
+
+    root = model.root
+    if model.is_xacro:
+        try:
+            root, _ = xmlsource.parse(xmlsource.normalize(model.source_bytes)[0], model.path)
+        except UserError:
+            return []
+    return [*root.itersiblings(etree.Comment, preceding=True), *root.iter(etree.Comment),
+            *root.itersiblings(etree.Comment)]
 
 
 def _codes(text: str | None) -> list[str]:
@@ -581,19 +819,24 @@ def summarize(results: list[LintResult], fail_on: Severity) -> dict[str, Any]:
     at or above ``fail_on`` (what passes the gate: an info finding such as P003 leaves a file clean
     under the default ``--fail-on error``; ``scan`` calls the same files clean). ``failed`` is the
     verdict of the summary line: a finding at or above ``fail_on`` (``findings_failing``), or a file
-    not checked.
+    not checked. ``suppressed``
+    counts the findings not reported by what suppressed them (:data:`SUPPRESSED_BY`), and
+    ``severity_lowered`` those the configuration made less severe.
     """
     findings = [f for r in results for f in r.findings]
     counts = {level.value: sum(f.severity == level for f in findings) for level in Severity}
     failing = sum(f.severity >= fail_on for f in findings)
     not_checked = sum(r.error is not None for r in results)
+    held = Counter(item.by for r in results for item in r.suppressed)
     return {"files": len(results), "files_with_findings": sum(bool(r.findings) for r in results),
             "files_with_errors": sum(any(f.severity is Severity.ERROR for f in r.findings) for r in results),
             "files_not_checked": not_checked,
             "files_clean": sum(r.error is None and not any(f.severity >= fail_on for f in r.findings)
                                for r in results),
             "findings": len(findings), **counts, "fail_on": fail_on.value, "findings_failing": failing,
-            "failed": bool(failing or not_checked)}
+            "failed": bool(failing or not_checked),
+            "suppressed": {by: held[by] for by in SUPPRESSED_BY},
+            "severity_lowered": sum(r.lowered for r in results)}
 
 
 def find_rule(code: str) -> Rule:

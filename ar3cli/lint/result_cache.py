@@ -71,14 +71,13 @@ class ResultCache:
     """Remembered findings for one lint run's settings (rules, options, environment)."""
 
     @classmethod
-    def for_settings(cls, rules: list[str], per_file_ignores: Mapping[str, list[str]],
-                     severity: Mapping[str, Severity], package_paths: Mapping[str, Path],
+    def for_settings(cls, rules: list[str], package_paths: Mapping[str, Path],
                      xacro_args: Mapping[str, str], targets: tuple[str, ...] = ()) -> ResultCache:
         """The cache for a run with these rule codes and options (package folders made absolute:
         a relative one means another folder from another working directory; the target engines set
-        the severity of target-bound rules)."""
-        return cls(repr((list(rules), sorted(targets), sorted(per_file_ignores.items()),
-                         sorted((code, level.value) for code, level in severity.items()),
+        the severity of target-bound rules). What the configuration suppresses or re-grades is
+        applied after the cache (``lint.engine.settle``), so it is no part of the key."""
+        return cls(repr((list(rules), sorted(targets),
                          sorted((name, os.path.abspath(folder)) for name, folder in package_paths.items()),
                          sorted(xacro_args.items()))))
 
@@ -97,8 +96,9 @@ class ResultCache:
             digest.update(part.encode("utf-8", "surrogateescape") + b"\0")
         return digest.hexdigest()
 
-    def get(self, path: Path, shown: str) -> list[Finding] | None:
-        """The findings remembered for this file, or None when it must be checked."""
+    def get(self, path: Path, shown: str) -> tuple[list[Finding], list[Finding], str] | None:
+        """The findings remembered for this file, those its own comments suppress and the SHA-256
+        of its bytes, or None when it must be checked."""
         entry = _STORE.lookup(self._key(path, shown), near=path)
         content = _read(path) if entry is not MISSING else None  # a file never seen is not read twice
         if content is None:
@@ -108,19 +108,21 @@ class ResultCache:
                 return None
             if any(_as_stored(path_state(dependency)) != state for dependency, state in entry["depends"].items()):
                 return None
-            return [_finding(shown, *fields) for fields in entry["findings"]]
+            return ([_finding(shown, *fields) for fields in entry["findings"]],
+                    [_finding(shown, *fields) for fields in entry["suppressed"]], entry["content"])
         except (KeyError, TypeError, ValueError, AttributeError):  # none, or damaged: check the file
             return None
 
     def put(self, path: Path, shown: str, content: bytes, findings: list[Finding],
-            depends: Mapping[str, PathState | None]) -> None:
-        """Remember the findings of ``path`` as it was when read (``content``) and the state of every
-        path they depended on *when it was looked at* (a path that changes while the file is being
-        checked then makes the entry stale at once)."""
+            depends: Mapping[str, PathState | None], suppressed: list[Finding] = ()) -> None:
+        """Remember the findings of ``path`` as it was when read (``content``), those its own comments
+        ``suppressed``, and the state of every path they depended on *when it was looked at* (a path
+        that changes while the file is being checked then makes the entry stale at once)."""
         _STORE.store(self._key(path, shown), near=path, value={
             "content": hashlib.sha256(content).hexdigest(),
             "depends": {dependency: _as_stored(state) for dependency, state in depends.items()},
             "findings": [[f.rule, f.severity.value, f.message, f.line, f.column, f.hint] for f in findings],
+            "suppressed": [[f.rule, f.severity.value, f.message, f.line, f.column, f.hint] for f in suppressed],
         })
 
 

@@ -45,7 +45,11 @@ def symmetric_eigenvalues(matrix: Matrix3) -> tuple[float, float, float]:
         return (math.nan, math.nan, math.nan)
     if a12 == 0.0 and a13 == 0.0 and a23 == 0.0:
         return tuple(sorted((a11, a22, a33)))  # type: ignore[return-value]
-    scale = math.ldexp(1.0, math.frexp(max(map(abs, entries)))[1])  # power of two: scaling is exact
+    exponent = math.frexp(max(map(abs, entries)))[1]
+    if exponent > MAX_EXPONENT:  # entries near the largest float: 2**1024 itself does not exist
+        entries = tuple(value / 2.0 for value in entries)
+        return tuple(value * 2.0 for value in symmetric_eigenvalues(_matrix(entries)))  # type: ignore[return-value]
+    scale = math.ldexp(1.0, exponent)  # power of two: scaling is exact
     a11, a22, a33, a12, a13, a23 = (value / scale for value in entries)
     q = (a11 + a22 + a33) / 3.0
     b11, b22, b33 = a11 - q, a22 - q, a33 - q
@@ -72,6 +76,16 @@ def symmetric_eigenvalues(matrix: Matrix3) -> tuple[float, float, float]:
     centre, radius = 0.5 * (m00 + m11), math.hypot(0.5 * (m00 - m11), m01)
     values = [(q + p * beta) * scale for beta in (isolated, centre - radius, centre + radius)]
     return _refine_near_singular(entries, values)
+
+
+MAX_EXPONENT = 1023
+"""The largest ``frexp`` exponent whose power of two is a float."""
+
+
+def _matrix(entries: tuple[float, ...]) -> Matrix3:
+    """The symmetric matrix of (a11, a22, a33, a12, a13, a23)."""
+    a11, a22, a33, a12, a13, a23 = entries
+    return ((a11, a12, a13), (a12, a22, a23), (a13, a23, a33))
 
 
 def _refine_near_singular(entries: tuple[float, ...], values: list[float]) -> tuple[float, float, float]:
@@ -130,9 +144,22 @@ def satisfies_triangle_inequality(matrix: Matrix3, tol: float = 1e-12) -> bool:
     return a + b + tol >= c and a + c + tol >= b and b + c + tol >= a
 
 
+def vector_length(parts: Sequence[float]) -> float:
+    """The Euclidean length of ``parts``: ``sqrt`` of the squares summed in order (the same floats as
+    that expression everywhere it fits), and ``math.hypot`` where a square overflows (components past
+    1e154, which a file may hold: a float ``**`` raises OverflowError there instead of giving inf)."""
+    try:
+        return math.sqrt(sum([part ** 2 for part in parts]))
+    except OverflowError:
+        return math.hypot(*parts)
+
+
 def rpy_to_matrix(rpy: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
-    """Rotation matrix (rows) of URDF roll-pitch-yaw: ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``."""
+    """Rotation matrix (rows) of URDF roll-pitch-yaw: ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``; NaN rows
+    for an infinite or NaN angle (which has no rotation: lint's F007 reports the value)."""
     roll, pitch, yaw = (float(angle) for angle in rpy)
+    if not (math.isfinite(roll) and math.isfinite(pitch) and math.isfinite(yaw)):
+        return ((math.nan,) * 3,) * 3
     cr, sr = math.cos(roll), math.sin(roll)
     cp, sp = math.cos(pitch), math.sin(pitch)
     cy, sy = math.cos(yaw), math.sin(yaw)

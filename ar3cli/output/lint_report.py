@@ -20,9 +20,10 @@ from ar3cli.output.report import Report, log
 class LintReport:
     """A lint run, before it is given a format.
 
-    ``results`` are the linter's per-file results (``path``, ``findings``, ``error``, ``cached`` and
-    ``to_dict()``); ``data`` is the JSON document (``files``, ``findings`` with ``fixed_by``,
-    ``summary``), which the json format prints and the html page embeds.
+    ``results`` are the linter's per-file results (``path``, ``findings``, ``error``, ``cached``,
+    ``suppressed`` (each with its ``finding`` and what suppressed it, ``by``) and ``to_dict()``);
+    ``data`` is the JSON document (``files``, ``findings`` with ``fixed_by``, ``summary``,
+    ``suppressed``), which the json format prints and the html page embeds.
     """
 
     results: list[Any]
@@ -69,8 +70,31 @@ def summary_line(summary: dict, cached: int = 0) -> str:
         held = f"; {summary['baselined']} baselined" + (
             f" ({unused} more in the baseline no longer found: --write-baseline drops them)" if unused else "")
     return (f"{verdict}: {files} file{'s' if files != 1 else ''} checked, {summary['error']} errors, "
-            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{held}{unchecked}{remembered} "
-            f"(fail-on: {summary['fail_on']})")
+            f"{summary['warning']} warnings, {summary['info']} info; {clean} clean{held}{suppressed_clause(summary)}"
+            f"{unchecked}{remembered} (fail-on: {summary['fail_on']}{'; --isolated' if summary.get('isolated') else ''})")
+
+
+def suppressed_clause(summary: dict) -> str:
+    """``; 7 suppressed (5 by pyproject.toml, 2 by comments in the files); 1 made less severe by
+    pyproject.toml``: what the configuration and the files' own comments kept from the verdict
+    (the baseline has its own clause), empty when nothing was."""
+    counts = summary.get("suppressed") or {}
+    config = config_name(summary.get("config_file"))
+    parts = [f"{counts[by]} by {what}" for by, what in (("config", config), ("comment", "comments in the files"))
+             if counts.get(by)]
+    text = f"; {sum(counts.get(by, 0) for by in ('config', 'comment'))} suppressed ({', '.join(parts)})" if parts else ""
+    lowered = summary.get("severity_lowered") or 0
+    return text + (f"; {lowered} made less severe by {config}" if lowered else "")
+
+
+def config_name(path: str | None) -> str:
+    """The configuration file as a message names it: relative to the current folder when below it."""
+    if not path:
+        return "the configuration"
+    import os
+
+    relative = os.path.relpath(path)
+    return path if relative.startswith("..") else relative
 
 
 def completed(lint: LintReport, report: Report, *, text: bool = False, hints: bool = False) -> Report:

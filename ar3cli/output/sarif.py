@@ -26,6 +26,11 @@ def artifact_uri(path: str) -> str:
     return Path(relative).as_posix() if not relative.startswith("..") else candidate.as_uri()
 
 
+SUPPRESSION_KINDS = {"comment": "inSource", "config": "external", "baseline": "external"}
+"""SARIF's ``suppression.kind`` of each thing that suppresses a finding (a comment in the file is
+in source; the configuration and a baseline are outside it)."""
+
+
 def _physical(finding: Finding) -> dict[str, Any]:
     location: dict[str, Any] = {"artifactLocation": {"uri": artifact_uri(finding.path)}}
     if finding.line:
@@ -33,9 +38,12 @@ def _physical(finding: Finding) -> dict[str, Any]:
     return location
 
 
-def sarif_document(findings: list[Finding], rules, grouped: bool = True) -> dict[str, Any]:
+def sarif_document(findings: list[Finding], rules, grouped: bool = True,
+                   suppressed: list[tuple[Finding, str, str]] = ()) -> dict[str, Any]:
     """One SARIF log with one run: the tool's rule metadata and one result per rule and file (its
-    other findings as ``relatedLocations``, errors first); ``grouped`` False: a result per finding."""
+    other findings as ``relatedLocations``, errors first); ``grouped`` False: a result per finding.
+    Each ``suppressed`` (finding, by, justification) is a result too, with its ``suppressions``, so
+    code scanning shows it as dismissed instead of never seeing it."""
     index = {rule.code: i for i, rule in enumerate(rules)}
     driver = {
         "name": "ar3cli",
@@ -68,5 +76,13 @@ def sarif_document(findings: list[Finding], rules, grouped: bool = True) -> dict
                                           for number, finding in enumerate(group.findings[1:], 1)]
         if first.rule in index:
             result["ruleIndex"] = index[first.rule]
+        results.append(result)
+    for finding, by, justification in suppressed:
+        result = {"ruleId": finding.rule, "level": LEVELS[finding.severity],
+                  "message": {"text": finding.message + (f" Fix: {finding.hint}" if finding.hint else "")},
+                  "locations": [{"physicalLocation": _physical(finding)}],
+                  "suppressions": [{"kind": SUPPRESSION_KINDS[by], "justification": justification}]}
+        if finding.rule in index:
+            result["ruleIndex"] = index[finding.rule]
         results.append(result)
     return {"$schema": SCHEMA, "version": "2.1.0", "runs": [{"tool": {"driver": driver}, "results": results}]}

@@ -1,4 +1,5 @@
-"""One side of a diff: a file on disk, or ``REV:path``, a file as a git revision holds it.
+"""One side of a diff: a file on disk, or ``REV:path``, a file as a git revision holds it
+(:func:`read_spec`: a revision whenever REV resolves in git, never a file that happens to have that name).
 
 A revision is read with git only, never checked out: the robot's folder as ``REV`` holds it is
 copied into a private temporary folder, removed when the diff is done (a process killed by a signal
@@ -62,14 +63,58 @@ def git(root: Path | str, *args: str) -> subprocess.CompletedProcess:
     return run_git(root, *args, purpose="reading a git revision")
 
 
-def split_spec(spec: str) -> tuple[str | None, str]:
-    """``REV:path`` -> (REV, path); a path (one that exists, or has no colon) -> (None, path)."""
-    if os.path.lexists(spec) or ":" not in spec:
-        return None, spec
+@dataclass(frozen=True)
+class SideSpec:
+    """What one side names: ``path`` (relative to the current folder) as git ``revision`` holds it,
+    or on disk when ``revision`` is None; ``label`` is how it is shown (``REV:path`` or the path)."""
+
+    label: str
+    path: str
+    revision: str | None = None
+
+    @classmethod
+    def at(cls, revision: str, path: str) -> SideSpec:
+        """``path`` as ``revision`` holds it, whatever is on disk (``--old-rev``, ``--changed-since``)."""
+        return cls(f"{revision}:{path}", path, revision)
+
+
+def read_spec(spec: str) -> tuple[SideSpec, str | None]:
+    """The side a command-line argument names, and a note saying how it was read when it has a colon.
+
+    ``REV:path`` is a revision whenever REV resolves to a commit in the repository holding ``path``,
+    even if a file of that very name exists: a pull request can commit a folder named
+    ``origin/main:robots`` and must not become its own old side. Otherwise the argument is a path
+    (``./REV:path`` always is one). Neither: a one-line UserError."""
+    if ":" not in spec:
+        if not os.path.lexists(spec):
+            raise UserError(f"{spec}: no such file or directory")
+        return SideSpec(spec, spec), None
     revision, _, path = spec.partition(":")
+    commit, why = _commit_of(revision, path) if revision and path and not revision.startswith("-") else (None, "")
+    if commit is not None:
+        return SideSpec(spec, path, revision), (f"{spec}: the file {path} as git revision {revision} ({commit[:12]}) "
+                                                "holds it" + (" (not the file of that name: write ./" + spec + " for it)"
+                                                              if os.path.lexists(spec) else ""))
+    if os.path.lexists(spec):
+        return SideSpec(spec, spec), f"{spec}: the file of that name ({revision} is no git revision here)"
     if not revision or not path or revision.startswith("-"):
         raise UserError(f"{spec!r}: expected a path or REV:path (a git revision, a colon, a path)")
-    return revision, path
+    raise UserError(f"{spec}: no such file or directory, and {why} (REV:path reads the file as git revision REV "
+                    "holds it)")
+
+
+def _commit_of(revision: str, path: str) -> tuple[str | None, str]:
+    """The commit ``revision`` names in the repository holding ``path``, or None and why not (no
+    repository, or no such revision there)."""
+    folder = _existing_folder(Path(os.path.abspath(path)))
+    done = git(folder, "rev-parse", "--show-toplevel")
+    if done.returncode != 0:
+        return None, f"{path} is not in a git working tree"
+    root = os.fsdecode(done.stdout).strip()
+    found = git(Path(root), "rev-parse", "--verify", "--quiet", "--end-of-options", f"{revision}^{{commit}}")
+    if found.returncode != 0:
+        return None, f"{revision} is an unknown git revision in {root}"
+    return os.fsdecode(found.stdout).strip(), ""
 
 
 def _existing_folder(path: Path) -> Path:
@@ -141,28 +186,28 @@ def _tree_size(root: Path, commit: str, folder: str) -> int:
 
 
 @contextlib.contextmanager
-def open_side(spec: str) -> Iterator[Side]:
+def open_side(spec: SideSpec) -> Iterator[Side]:
     """The :class:`Side` ``spec`` names; a revision's copy exists while the ``with`` block runs."""
-    revision, path = split_spec(spec)
+    revision, path = spec.revision, spec.path
     if revision is None:
         if not os.path.lexists(path):
             raise UserError(f"{path}: no such file or directory")
-        yield Side(spec, Path(path))
+        yield Side(spec.label, Path(path))
         return
     root, inside = repository_path(path)
     commit = resolve_commit(root, revision)
     if not exists_at(root, commit, inside):
-        raise UserError(f"{spec}: {revision} has no file {inside}")
+        raise UserError(f"{spec.label}: {revision} has no file {inside}")
     folder = package_folder(root, commit, inside)
     size = _tree_size(root, commit, folder)
     if size > MAX_BYTES:
-        raise UserError(f"{spec}: the folder {folder} at {revision} holds {size / 1e6:.0f} MB, more than the "
+        raise UserError(f"{spec.label}: the folder {folder} at {revision} holds {size / 1e6:.0f} MB, more than the "
                         f"{MAX_BYTES // 2**20} MiB ar3cli copies out of a revision")
     archive = git(root, "archive", "--format=tar", commit, "--", folder)
     if archive.returncode != 0:
-        raise UserError(f"{spec}: git archive failed: {' '.join(os.fsdecode(archive.stderr).split())}")
+        raise UserError(f"{spec.label}: git archive failed: {' '.join(os.fsdecode(archive.stderr).split())}")
     with tempfile.TemporaryDirectory(prefix="ar3cli-diff-") as temporary:
         copy = Path(temporary) / "rev"
         copy.mkdir()
         _extract(archive.stdout, copy)
-        yield Side(spec, copy / inside, revision, copy, root)
+        yield Side(spec.label, copy / inside, revision, copy, root)

@@ -11,7 +11,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from ar3cli.maths.tensor_math import rpy_to_matrix
+from ar3cli.maths.tensor_math import rpy_to_matrix, vector_length
 
 DEFAULT = 1e-9
 """Default for all three tolerances: far below any manufacturing tolerance, far above the rounding
@@ -49,7 +49,7 @@ class Tolerance:
 
 
 def distance(a: Sequence[float], b: Sequence[float]) -> float:
-    return math.sqrt(sum((x - y) ** 2 for x, y in zip(a, b)))
+    return vector_length([x - y for x, y in zip(a, b)])
 
 
 def rotation_angle(rpy_a: Sequence[float], rpy_b: Sequence[float]) -> float:

@@ -131,7 +131,7 @@ def _rows(todo: dict[str, str], settings: ScanSettings, backend: Backend) -> Ite
         yield from ray_rows(todo, settings, backend.jobs, backend.timeout, backend.address)
         return
     from ar3cli.infra.process_pool import available_cpus
-    from ar3cli.scan.pool import stream
+    from ar3cli.infra.streaming_pool import stream
     from ar3cli.scan.worker import check_file, row_from_outcome
 
     workers = max(1, min(backend.jobs or available_cpus(), available_cpus(), len(todo)))

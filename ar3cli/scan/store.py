@@ -11,11 +11,14 @@ primary key, so a file is never stored twice; a changed file replaces its row.
 from __future__ import annotations
 
 import json
+import os
 import sqlite3
+import stat
 from collections.abc import Iterable, Iterator
 from pathlib import Path
 
 from ar3cli.errors import UserError
+from ar3cli.infra.atomic import check_writable
 from ar3cli.scan.record import LOADED, Row, status_of
 
 SCHEMA_VERSION = 1
@@ -53,6 +56,30 @@ def storable(text: str) -> str:
         return text.encode("utf-8", "backslashreplace").decode("utf-8")
 
 
+SIDE_FILES = ("-wal", "-shm", "-journal")
+"""The files SQLite keeps beside the store (write-ahead log, its index, the rollback journal)."""
+
+
+def _check_writable(path: Path) -> None:
+    """The safe-write rules for a store SQLite writes in place (:mod:`ar3cli.infra.atomic`): the store
+    and the files SQLite keeps beside it may not be symbolic links (a link planted as
+    ``scan.sqlite-wal`` would have SQLite write through it), FIFOs, devices or read-only files;
+    UserError (exit 2) before anything is opened. An existing store keeps its mode, owner and group
+    (SQLite writes into it)."""
+    check_writable(path)
+    for suffix in SIDE_FILES:
+        side = Path(f"{path}{suffix}")
+        try:
+            mode = os.lstat(side).st_mode
+        except FileNotFoundError:
+            continue
+        except OSError as exc:
+            raise UserError(f"{side}: cannot write: {exc.strerror or exc}") from None
+        if stat.S_ISLNK(mode) or not stat.S_ISREG(mode):
+            raise UserError(f"{side}: SQLite's {suffix[1:]} file of the store is not a regular file (a symbolic link, "
+                            "FIFO or device); refusing to write through it: remove it")
+
+
 class Store:
     """An open scan store; use as a context manager. ``readonly`` opens an existing store for a report."""
 
@@ -64,6 +91,7 @@ class Store:
             if readonly:
                 self.db = sqlite3.connect(f"{self.path.resolve().as_uri()}?mode=ro", uri=True)
             else:
+                _check_writable(self.path)
                 self.db = sqlite3.connect(self.path, timeout=30)
                 self.db.execute("PRAGMA journal_mode=WAL")
                 self.db.execute("PRAGMA synchronous=NORMAL")  # WAL: a commit survives a killed process

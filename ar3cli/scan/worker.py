@@ -93,7 +93,7 @@ def row_from_outcome(path: str, outcome: tuple[str, Any], sha: str, key: str) ->
 
 def check_batch(paths: list[tuple[str, str]], settings: ScanSettings, timeout: float | None) -> list[Row]:
     """Check ``(path, sha)`` pairs in one forked worker with the per-file limit: a Ray task's work."""
-    from ar3cli.scan.pool import stream
+    from ar3cli.infra.streaming_pool import stream
 
     shas = dict(paths)
     rows = [row_from_outcome(path, outcome, shas[path], settings.key)

@@ -159,6 +159,8 @@ def loadable_document(model: Model, visuals: bool = True, lines: LineMap | None 
         if resolution.found:
             element.set("filename", str(resolution.path))
             leave_out_unloadable_mesh(element, resolution.path)  # over the mesh cap, or a FIFO: lint's G011
+        elif resolution.refused is not None:  # a FIFO, a device or a folder where the mesh should be: G001
+            leave_out_unloadable_mesh(element, resolution.refused)
     document = etree.tostring(root, xml_declaration=True, encoding="utf-8")
     if lines is not None:
         lines.update(line_map(model, root, document))

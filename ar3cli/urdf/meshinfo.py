@@ -26,7 +26,7 @@ from pathlib import Path
 
 from ar3cli.errors import UserError
 from ar3cli.infra.file_cache import MISSING, file_facts
-from ar3cli.infra.safe_read import read_bytes, read_head, too_large
+from ar3cli.infra.safe_read import kind_of, read_bytes, read_head, too_large
 
 PYBULLET_MESH_FORMATS = (".stl", ".obj", ".dae")
 """What PyBullet's URDF importer loads (anything else: "invalid mesh filename extension", and the
@@ -79,7 +79,7 @@ def mesh_refusal(path: Path) -> str | None:
     except OSError as exc:
         return f"{path}: cannot read: {exc.strerror or exc}"
     if not stat_module.S_ISREG(status.st_mode):
-        return f"{path}: not a regular file (a pipe, socket or device); expected a mesh"
+        return f"{path}: not a regular file ({kind_of(status.st_mode)}); expected a mesh"
     if status.st_size > MAX_MESH_BYTES:
         return too_large(path, status.st_size, MAX_MESH_BYTES, "a mesh")
     return None

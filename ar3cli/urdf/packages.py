@@ -16,16 +16,18 @@ So the search is explicit, in this order, and every place tried is remembered fo
 
 from __future__ import annotations
 
+import dataclasses
 import os
 import re
-from collections.abc import Mapping
+import stat
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import cached_property, lru_cache
 from pathlib import Path
 from urllib.parse import unquote
 
-from ar3cli.findings import listed
 from ar3cli.infra.file_cache import PathState, path_state
+from ar3cli.infra.safe_read import kind_of
 
 _PACKAGE_NAME = re.compile(rb"<name>\s*([^<\s]+)\s*</name>")
 
@@ -40,10 +42,20 @@ class Resolution:
     problem: str = ""
     via: str = ""
     """How it was found: ``direct``, ``package`` or ``pybullet-search`` (empty when not found)."""
+    refused: Path | None = None
+    """The place the search stopped at because something other than a regular file is there (a
+    FIFO, a device, a folder): never read, never handed to pybullet (which would block on a FIFO)."""
+
+    folder: str = ""
+    """The robot file's folder (the resolver's), for :meth:`places`."""
 
     @property
     def found(self) -> bool:
         return self.path is not None
+
+    def places(self) -> str:
+        """Where the search looked, for a message (:func:`shown_places`)."""
+        return shown_places(self.tried, self.folder)
 
     def explain(self) -> str:
         """One line for error messages: why the URI did not resolve and where we looked."""
@@ -51,8 +63,37 @@ class Resolution:
             return f"{self.uri} -> {self.path}"
         reason = self.problem or "not found"
         if self.tried:
-            return f"{self.uri}: {reason}; tried {listed(self.tried)}"
+            return f"{self.uri}: {reason}; tried {self.places()}"
         return f"{self.uri}: {reason}"
+
+
+def shown_places(places: Sequence[str], folder: str | os.PathLike[str]) -> str:
+    """The places a search tried, as a message shows them: those inside the current folder (relative
+    to it) or inside the robot's ``folder``, in order; the others (the folders above the checkout,
+    ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` entries) only counted. Their names are the
+    machine's layout, not the robot's, and a linted pull request must not learn it
+    (docs/security.md)."""
+    here = os.getcwd()
+    roots = [root.rstrip(os.sep) + os.sep for root in (here, os.fspath(folder)) if root]
+    shown: list[str] = []
+    hidden = 0
+    for place in places:
+        absolute = os.path.abspath(place) if not place.startswith(ANCESTORS) else place
+        if place.startswith(ANCESTORS):
+            shown.append(place)
+        elif absolute.startswith(roots[0]):
+            shown.append(os.path.relpath(absolute, here))
+        elif any(absolute.startswith(root) for root in roots[1:]):
+            shown.append(place)
+        else:
+            hidden += 1
+    if hidden:
+        shown.append(f"{hidden} place{'s' if hidden != 1 else ''} outside the robot's folder")
+    return ", ".join(shown)
+
+
+ANCESTORS = "ancestors of the robot's folder"
+"""How the package search's walk up the folders is named among the places tried."""
 
 
 def parse_package_paths(items: list[str] | None) -> dict[str, Path]:
@@ -140,7 +181,27 @@ class PackageResolver:
     def is_file(self, path: Path) -> bool:
         """Whether ``path`` is a regular file, remembered in :attr:`probed` like every path a resolution
         looks at (a lint rule that resolves a path its own way, as MuJoCo would, asks here)."""
-        return self._probe(path).is_file()
+        return self._kind(path) == "file"
+
+    def _kind(self, path: Path) -> str | None:
+        """What is at ``path`` (symlinks followed, state remembered in :attr:`probed`): ``"file"`` for
+        a regular file, None for nothing (or a path the OS refuses, such as a name over 255 bytes),
+        else what it is (:func:`~ar3cli.infra.safe_read.kind_of`)."""
+        self._probe(path)
+        state = self.probed[str(path)]
+        if state is None:
+            return None
+        return "file" if stat.S_ISREG(state[3]) else kind_of(state[3])
+
+    def _found(self, uri: str, candidate: Path, tried: tuple[str, ...], via: str) -> Resolution | None:
+        """The resolution when ``candidate`` ends the search: a regular file is found; anything else
+        that is there stops it too (pybullet would open it: a FIFO blocks it) and is refused."""
+        kind = self._kind(candidate)
+        if kind is None:
+            return None
+        if kind == "file":
+            return Resolution(uri, candidate, tried, via=via)
+        return Resolution(uri, None, tried, f"not a regular file ({kind})", refused=candidate)
 
     def _package_name(self, folder: Path) -> str | None:
         manifest = folder / "package.xml"
@@ -158,7 +219,7 @@ class PackageResolver:
 
         def accept(candidate: Path) -> bool:
             tried.append(str(candidate))
-            return self._probe(candidate).is_dir()
+            return self._kind(candidate) == "a folder"
 
         if name in self.package_paths and accept(self.package_paths[name]):
             return self.package_paths[name], tuple(tried)
@@ -173,18 +234,18 @@ class PackageResolver:
         for ancestor in self._ancestors:
             if ancestor.name == name or self._package_name(ancestor) == name:
                 return ancestor, tuple(tried)
-            sibling = self._probe(ancestor / name)
-            if sibling.is_dir() and self._package_name(sibling) in (name, None) \
+            sibling = ancestor / name
+            if self._kind(sibling) == "a folder" and self._package_name(sibling) in (name, None) \
                     and self.probed[str(sibling / "package.xml")] is not None:  # the manifest exists
                 return sibling, tuple(tried)
-        tried.append(f"ancestors of {self.base_dir} named {name} or with package.xml <name>{name}</name>")
+        tried.append(f"{ANCESTORS} named {name} or with package.xml <name>{name}</name>")
         return None, tuple(tried)
 
     def resolve(self, uri: str) -> Resolution:
         """Resolve one URI as found in a ``filename`` attribute (once per resolver: a visual and
         its collision usually share their mesh)."""
         if uri not in self._resolutions:
-            self._resolutions[uri] = self._resolve(uri)
+            self._resolutions[uri] = dataclasses.replace(self._resolve(uri), folder=str(self.base_dir))
         return self._resolutions[uri]
 
     def _resolve(self, uri: str) -> Resolution:
@@ -197,8 +258,9 @@ class PackageResolver:
             if folder is not None:
                 candidate = folder / unquote(rest)
                 tried = (*tried, str(candidate))
-                if self._probe(candidate).is_file():
-                    return Resolution(uri, candidate, tried, via="package")
+                found = self._found(uri, candidate, tried, "package")
+                if found is not None:
+                    return found
             return self._pybullet_search(uri, unquote(uri[len("package://"):]), tried,
                                          f"package '{name}' not found" if folder is None else "file not found in package")
         if uri.startswith("file://"):
@@ -209,8 +271,9 @@ class PackageResolver:
             candidate = Path(uri)
         if not candidate.is_absolute():
             candidate = self.base_dir / candidate
-        if self._probe(candidate).is_file():
-            return Resolution(uri, candidate, (str(candidate),), via="direct")
+        found = self._found(uri, candidate, (str(candidate),), "direct")
+        if found is not None:
+            return found
         if Path(uri).is_absolute() or uri.startswith("file://"):
             return Resolution(uri, None, (str(candidate),), "file not found")
         return self._pybullet_search(uri, uri, (str(candidate),), "file not found")
@@ -222,6 +285,7 @@ class PackageResolver:
             candidate = folder / relative
             if str(candidate) not in tried:
                 tried = (*tried, str(candidate))
-            if self._probe(candidate).is_file():
-                return Resolution(uri, candidate, tried, via="pybullet-search")
+            found = self._found(uri, candidate, tried, "pybullet-search")
+            if found is not None:
+                return found
         return Resolution(uri, None, tried, problem)

@@ -32,7 +32,7 @@ from ar3cli.errors import UserError
 from ar3cli.findings import listed
 from ar3cli.infra.safe_read import MAX_FILE_BYTES
 from ar3cli.output.report import log
-from ar3cli.urdf.packages import PackageResolver
+from ar3cli.urdf.packages import PackageResolver, shown_places
 from ar3cli.urdf.xacro_safe import ReadRoots, XacroPolicy, read_inside, safe_hooks
 
 
@@ -56,11 +56,13 @@ class Expansion:
     A :class:`~ar3cli.urdf.model.Model` holds its own (``Model.expansion``), so :func:`origins`
     answers for every model still in use (an editor's open files), not only the last few."""
 
-    __slots__ = ("found", "included", "__weakref__")
+    __slots__ = ("found", "included", "digests", "__weakref__")
 
-    def __init__(self, found: list[Origin | None], included: list[str]) -> None:
+    def __init__(self, found: list[Origin | None], included: list[str], digests: dict[str, str]) -> None:
         self.found = found
         self.included = included
+        self.digests = digests
+        """Each xacro file parsed (as xacro named it) -> the SHA-256 of the bytes parsed."""
 
 
 _origins: weakref.WeakValueDictionary[bytes, Expansion] = weakref.WeakValueDictionary()
@@ -101,12 +103,14 @@ MEMORY_BYTES = 1024 * 1024 * 1024
 
 
 class _Expansion(NamedTuple):
-    """What the child sends back: the URDF, its elements' origins, the files xacro read, xacro's chatter."""
+    """What the child sends back: the URDF, its elements' origins, the files xacro read, xacro's
+    chatter, and the SHA-256 of the bytes of each xacro file it parsed."""
 
     data: bytes
     found: list[Origin | None]
     included: list[str]
     notes: list[str]
+    digests: dict[str, str]
 
 
 def expand(path: Path, args: dict[str, str], resolver: PackageResolver, source: bytes | None = None) -> bytes:
@@ -140,7 +144,7 @@ def expand(path: Path, args: dict[str, str], resolver: PackageResolver, source: 
         raise UserError(f"{path}: xacro error: the expansion died ({exc.signal_name})") from None
     for line in result.notes:
         log(f"ar3cli: note: {path}: xacro says: {line}")
-    kept = Expansion(result.found, result.included)
+    kept = Expansion(result.found, result.included, result.digests)
     _origins[result.data] = kept
     _recent.append(kept)
     return result.data
@@ -150,6 +154,14 @@ def included_files(xml_bytes: bytes) -> list[str]:
     """The files xacro read (includes, YAML) for an expansion :func:`expand` returned, as xacro named them."""
     kept = _origins.get(xml_bytes)
     return list(kept.included) if kept is not None else []
+
+
+def parsed_digests(xml_bytes: bytes) -> dict[str, str]:
+    """For an expansion :func:`expand` returned: each xacro file it parsed (as xacro named it, as
+    :class:`Origin` names it) -> the SHA-256 of the bytes parsed. What may be shown of those files
+    is exactly these bytes (a page's cited lines are checked against them)."""
+    kept = _origins.get(xml_bytes)
+    return dict(kept.digests) if kept is not None else {}
 
 
 def _limit_this_process() -> None:
@@ -189,7 +201,8 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
     def find_package(name: str) -> str:
         folder, tried = resolver.find_package(name)
         if folder is None:
-            failures.append(UserError(f"{path}: $(find {name}): package not found; tried {listed(tried)}; "
+            failures.append(UserError(f"{path}: $(find {name}): package not found; tried "
+                                      f"{shown_places(tried, resolver.base_dir)}; "
                                       f"pass --package-path {name}=DIR"))
             raise failures[-1]
         roots.add_package(folder)
@@ -197,9 +210,10 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
 
     table: list[Origin] = []
     kept: dict = {}
+    digests: dict[str, str] = {}
     original_find, original_parse = substitution_args._eval_find, xacro.parse
     substitution_args._eval_find = find_package
-    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots,
+    xacro.parse = _parse_with_origins(original_parse, table, kept, None if policy.trusted else roots, digests,
                                       {str(path): source} if source is not None else {})
     chatter = io.StringIO()
     included_before = len(xacro.all_includes)
@@ -233,7 +247,7 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
                         f"{MAX_FILE_BYTES >> 20} MB limit for robot descriptions")
     notes = [line.strip() for line in chatter.getvalue().splitlines()
              if line.strip() and not line.startswith("when processing file:")]
-    return _Expansion(data, found, [str(name) for name in xacro.all_includes[included_before:]], notes)
+    return _Expansion(data, found, [str(name) for name in xacro.all_includes[included_before:]], notes, digests)
 
 
 def _inert_banner(document) -> None:
@@ -342,7 +356,7 @@ def _arguments_hint(path: Path, given: dict[str, str]) -> str:
 
 
 def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: ReadRoots | None,
-                        sources: dict[str, bytes] | None = None):
+                        digests: dict[str, str], sources: dict[str, bytes] | None = None):
     """xacro's ``parse(inp, filename)``, noting the origin of each element read from a file.
 
     The file is read as xacro reads it (text, default encoding) and parsed by the builder
@@ -353,8 +367,10 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
     xacro to evaluate: 3 ms less on the AR3). xacro's own elements are left alone (xacro checks
     their attributes); inside ``xacro:if``/``xacro:unless`` nodes are moved, never copied.
     With ``roots`` (safe mode), an existing file is read only inside them, through the capped reader.
+    ``digests`` receives the SHA-256 of each file's bytes, by the name its elements' origins carry;
     ``sources`` maps a file name as xacro names it to the bytes that stand in for the file.
     """
+    import hashlib
     import locale
     from xml.dom import expatbuilder
 
@@ -396,15 +412,24 @@ def _parse_with_origins(original_parse, table: list[Origin], kept: dict, roots: 
             return original_parse(inp, filename)
         full = os.path.join(getattr(xacro, "root_dir", os.curdir), filename)
         if sources and str(filename) in sources:
+            digests[str(filename)] = hashlib.sha256(sources[str(filename)]).hexdigest()
             return Builder(str(filename)).parseString(sources[str(filename)].decode("utf-8", "replace"))
+        if roots is not None:
+            roots.check(full)  # outside: refused whether or not something is there
         if roots is not None and os.path.lexists(full):
-            text = read_inside(roots, full).decode(locale.getpreferredencoding(False))  # as open() decodes
+            data = read_inside(roots, full)
+            digests[str(filename)] = hashlib.sha256(data).hexdigest()
+            text = data.decode(locale.getpreferredencoding(False))  # as open() decodes
             return Builder(str(filename)).parseString(text)
         try:
             with open(full) as handle:
                 text = handle.read()
         except OSError:
             return original_parse(inp, filename)  # raises xacro's own error, with its file stack
+        with contextlib.suppress(UserError):  # trusted mode: the same file's bytes, through the capped reader
+            from ar3cli.infra.safe_read import read_bytes
+
+            digests[str(filename)] = hashlib.sha256(read_bytes(Path(full))).hexdigest()
         return Builder(str(filename)).parseString(text)
 
     return parse

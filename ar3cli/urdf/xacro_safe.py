@@ -8,7 +8,10 @@ xacro runs ``${...}`` and ``$(eval ...)`` through Python's ``eval``, reads any f
   are swapped for ours;
 - ``load_yaml`` and includes read only files inside the :class:`ReadRoots` (the robot file's
   folder tree and its packages), through :func:`~ar3cli.infra.safe_read.read_bytes` (size cap,
-  FIFOs and devices refused); YAML is parsed by ``yaml.safe_load``;
+  FIFOs and devices refused); YAML is parsed by ``yaml.safe_load``; an include pattern
+  (``filename="parts/*.xacro"``) lists only inside them (:meth:`ReadRoots.glob`), and a file
+  outside is refused whether or not it exists, so no answer tells what is there;
+- ``$(cwd)`` (the folder ar3cli runs in) is refused;
 - ``$(env X)`` and ``$(optenv X ...)`` are refused unless X was allowed with ``--xacro-env X``.
   ``$(optenv X default)`` is refused too rather than quietly taking the default: the robot would
   differ from the one the author's environment builds, with nothing said.
@@ -62,13 +65,35 @@ class ReadRoots:
         if (Path(folder) / "package.xml").is_file():
             self.folders.append(os.path.realpath(folder))
 
-    def check(self, filename: str) -> Path:
-        """``filename`` (symlinks resolved) when it lies inside a root; UserError otherwise."""
+    def inside(self, filename: str) -> bool:
+        """True when ``filename`` (symlinks resolved) lies inside a root."""
         real = os.path.realpath(filename)
-        if not any(real == root or real.startswith(root.rstrip(os.sep) + os.sep) for root in self.folders):
-            raise UserError(f"xacro may not read {filename}: it is outside the robot's folder and packages "
+        return any(real == root or real.startswith(root.rstrip(os.sep) + os.sep) for root in self.folders)
+
+    def check(self, filename: str, verb: str = "read", shown: str | None = None) -> Path:
+        """``filename`` (symlinks resolved) when it lies inside a root; UserError otherwise, naming
+        ``shown`` (default ``filename``, as the file wrote it), whether or not anything is there."""
+        if not self.inside(filename):
+            raise UserError(f"xacro may not {verb} {shown or filename}: it is outside the robot's folder and packages "
                             f"(safe mode; pass --package-path NAME=DIR for a package, or {xacro_eval.SAFE_MODE_HINT})")
-        return Path(real)
+        return Path(os.path.realpath(filename))
+
+    def glob(self, pattern: str) -> list[str]:
+        """``glob.glob(pattern)`` for ``<xacro:include filename="...*...">``, without listing anything
+        outside the roots: a pattern whose folder (the part before its first wildcard) lies outside,
+        or that climbs out with ``..`` after a wildcard, is one refusal naming the pattern (decided
+        by the pattern alone, so the answer says nothing about what is there); a match that leads
+        outside through a symbolic link inside the tree is left out, as if it were not there."""
+        import glob
+
+        parts = pattern.split(os.sep)
+        first = next(index for index, part in enumerate(parts) if glob.has_magic(part))
+        folder = os.sep.join(parts[:first]) or (os.sep if pattern.startswith(os.sep) else os.curdir)
+        if ".." in parts[first:]:  # climbs after a wildcard: names no single folder, refused
+            raise UserError(f"xacro may not list {pattern}: a pattern may not climb with '..' after a wildcard "
+                            f"(safe mode; {xacro_eval.SAFE_MODE_HINT})")
+        self.check(folder, verb="list", shown=pattern)
+        return [match for match in glob.glob(pattern) if self.inside(match)]
 
 
 def read_inside(roots: ReadRoots, filename: str) -> bytes:
@@ -89,6 +114,23 @@ def safe_hooks(policy: XacroPolicy, roots: ReadRoots, failures: list[UserError])
     def fail(exc: UserError) -> UserError:
         failures.append(exc)
         return exc
+
+    class ListInside:
+        """Stands for the ``glob`` module inside xacro: include patterns list only the roots."""
+
+        @staticmethod
+        def glob(pattern: str) -> list[str]:
+            try:
+                return roots.glob(pattern)
+            except UserError as exc:
+                raise fail(exc) from None
+
+    def extension(text: str) -> Any:
+        if text == "$(cwd)":  # the folder ar3cli runs in: where the runner keeps the checkout
+            raise fail(UserError("$(cwd): xacro may not read the working folder's path in safe mode (it shows "
+                                 "the layout outside the robot's folder); write paths relative to the file, or "
+                                 f"{xacro_eval.SAFE_MODE_HINT}"))
+        return original_extension(text)
 
     def read_env(name: str, default: str | None = None) -> str:
         if name not in policy.env:
@@ -116,18 +158,21 @@ def safe_hooks(policy: XacroPolicy, roots: ReadRoots, failures: list[UserError])
         xacro.all_includes.append(filename)
         return xacro.YamlListWrapper.wrap(data)
 
-    saved = (xacro.safe_eval, substitution_args._eval, substitution_args._eval_env, substitution_args._eval_optenv)
-    original_env = substitution_args._eval_env
+    saved = (xacro.safe_eval, xacro.glob, xacro.eval_extension, substitution_args._eval, substitution_args._eval_env,
+             substitution_args._eval_optenv)
+    original_env, original_extension = substitution_args._eval_env, xacro.eval_extension
     if not policy.trusted:
         xacro_globals = _expression_globals(xacro, load_yaml)
         xacro.safe_eval = lambda expr, symbols, _locals=None: _evaluate(expr, symbols, xacro_globals, xacro.Table)
+        xacro.glob = ListInside
+        xacro.eval_extension = extension
         substitution_args._eval = _eval_substitution(substitution_args, read_env)
         substitution_args._eval_env = read_env
         substitution_args._eval_optenv = lambda name, default="": read_env(name, default)
     try:
         yield
     finally:
-        (xacro.safe_eval, substitution_args._eval, substitution_args._eval_env,
+        (xacro.safe_eval, xacro.glob, xacro.eval_extension, substitution_args._eval, substitution_args._eval_env,
          substitution_args._eval_optenv) = saved
 
 

@@ -13,6 +13,7 @@ from collections.abc import Iterator
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.lint.rules.geometry import scale_mismatches
+from ar3cli.maths.tensor_math import vector_length
 from ar3cli.urdf.bounds import Box, box_around, box_union
 
 DETACHED_FACTOR = 1.0
@@ -53,8 +54,8 @@ def _diagonal(box: Box) -> float:
 def _gap(a: Box, b: Box) -> float:
     """Distance between two axis-aligned boxes (0 when they touch or overlap)."""
     (al, ah), (bl, bh) = a, b
-    return math.sqrt(sum([max(0.0, bl[0] - ah[0], al[0] - bh[0]) ** 2, max(0.0, bl[1] - ah[1], al[1] - bh[1]) ** 2,
-                          max(0.0, bl[2] - ah[2], al[2] - bh[2]) ** 2]))
+    return vector_length([max(0.0, bl[0] - ah[0], al[0] - bh[0]), max(0.0, bl[1] - ah[1], al[1] - bh[1]),
+                    max(0.0, bl[2] - ah[2], al[2] - bh[2])])
 
 
 def _moved(box: Box, rotation, translation) -> Box:
@@ -109,7 +110,7 @@ def detachment(ctx, link) -> tuple[float, float, object, object] | None:
     or None when there is nothing to compare with. The gap is the smallest distance from the link's
     box to its nearest geometric ancestor's box or to a sibling's box (other children of that ancestor)."""
     box = ctx.link_bounds(link)
-    if box is None:
+    if box is None or not all(map(math.isfinite, (*box[0], *box[1]))):
         return None
     found = _geometric_ancestor(ctx, link)
     if found is None:
@@ -241,13 +242,15 @@ def _line_box_distance(direction, box: Box) -> float:
     piece. That is a dozen evaluations (an 80-step ternary search cost G016 a quarter of a cold lint).
     """
     norm = math.sqrt(sum(v * v for v in direction))
+    if math.isinf(norm):  # a huge axis (1e200): its squares overflowed
+        norm = math.hypot(*direction)
     if not norm > 0:
         return 0.0
     u = [v / norm for v in direction]
     lows, highs = box
 
     def distance(t: float) -> float:
-        return math.sqrt(sum(max(0.0, lo - t * a, t * a - hi) ** 2 for a, lo, hi in zip(u, lows, highs)))
+        return vector_length([max(0.0, lo - t * a, t * a - hi) for a, lo, hi in zip(u, lows, highs)])
 
     breaks = sorted({bound / a for a, lo, hi in zip(u, lows, highs) if a != 0 for bound in (lo, hi)})
     candidates = list(breaks)
@@ -271,7 +274,7 @@ def axis_offset(ctx, joint) -> tuple[float, float] | None:
         return None
     child = ctx.model.link(joint.child)
     box = ctx.link_bounds(child) if child is not None else None
-    if box is None or not all(map(math.isfinite, joint.axis)):
+    if box is None or not all(map(math.isfinite, joint.axis)) or not all(map(math.isfinite, (*box[0], *box[1]))):
         return None
     return _line_box_distance(joint.axis, box), _diagonal(box)
 

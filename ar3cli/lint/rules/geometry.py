@@ -7,7 +7,6 @@ from collections.abc import Iterator
 from functools import lru_cache
 from pathlib import Path
 
-from ar3cli.findings import listed
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.lint.rules.file import SUBSTITUTION
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
@@ -73,7 +72,7 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
-            tried = "; looked in " + listed(resolution.tried) if resolution.tried else ""
+            tried = "; looked in " + resolution.places() if resolution.tried else ""
             also = ""
             if meshdir is not None and ctx.model.resolver.is_file(meshdir / _base_name(resolution.uri)):
                 others = [target for target in ctx.targets if target != "mujoco"]

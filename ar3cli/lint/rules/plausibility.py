@@ -89,7 +89,7 @@ def _primitive_volume(shape) -> float | None:
             return math.pi * r * r * length + (4 / 3 * math.pi * r ** 3 if kind == "capsule" else 0.0)
         if kind == "sphere":
             return 4 / 3 * math.pi * abs(params["radius"]) ** 3
-    except (KeyError, TypeError, ValueError):
+    except (KeyError, TypeError, ValueError, OverflowError):  # OverflowError: radius="1e200" cubed
         return None
     return None
 

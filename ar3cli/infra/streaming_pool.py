@@ -1,8 +1,8 @@
 """Forked workers that stream results back as each item finishes, with a time limit per item.
 
 :func:`~ar3cli.infra.process_pool.map_in_processes` answers once, in input order, when every share
-is done; a scan of 100,000 files must store each result as it arrives, stop one slow file without
-losing the others, and replace a worker that died. Here the parent hands out one item at a time
+is done; a lint or a scan of 100,000 files must have each result as it arrives, stop one slow
+file without losing the others, and replace a worker that died. Here the parent hands out one item at a time
 through a pipe, reads length-prefixed answers with ``select``, and for each item yields
 ``(item, outcome)``: an :data:`~ar3cli.infra.outcome.Outcome` (``("ok", result)``, ...), or
 ``("crash", message)`` when the worker died on it, or ``("timeout", message)`` when it ran past
@@ -28,9 +28,9 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from typing import Any, BinaryIO
 
-from ar3cli.infra import child_limits
+from ar3cli.infra import child_limits, process_pool
 from ar3cli.infra.outcome import capture, pickled
-from ar3cli.infra.process_pool import can_fork, child_signals, interrupts_deferred, stop_children
+from ar3cli.infra.process_pool import child_signals, interrupts_deferred, stop_children
 
 _HEADER = struct.Struct("<Q")
 
@@ -53,7 +53,7 @@ def stream(work: Callable[[Any], Any], items: Sequence[Any], workers: int,
 
     Where fork is not available the items run here, one after the other, without a time limit.
     """
-    if not can_fork():
+    if not process_pool.can_fork():
         for item in items:
             yield item, capture(lambda item=item: work(item))
         return
