@@ -73,10 +73,16 @@ def test_render_draws_the_rest_and_warns_once(iiwa_without_link_3: Path, cli, tm
 
 
 def test_lint_sim_still_says_pybullet_cannot_load_the_file_as_written(iiwa_without_link_3: Path, cli) -> None:
+    """The other commands go on without the mesh; lint does not pretend the file loads: G001 (an error
+    because pybullet refuses the file) names the mesh at its line, and P001, which would only restate
+    it, stays quiet (one cause, one finding)."""
     result = cli("lint-urdf", "--sim", "--no-cache", "--select", "P001,G001", str(iiwa_without_link_3),
                  "--format", "json")
-    rules = {finding["rule"] for finding in json.loads(result.stdout)["findings"]}
-    assert {"P001", "G001"} <= rules
+    assert result.code == 1, result.stderr
+    findings = json.loads(result.stdout)["findings"]
+    (missing,) = [finding for finding in findings if finding["rule"] == "G001"]
+    assert missing["severity"] == "error" and "link_3.stl" in missing["message"]
+    assert "P001" not in {finding["rule"] for finding in findings}
 
 
 def test_a_missing_cdf_geometry_is_left_out_too(pybullet_data_dir: Path, cli) -> None:
