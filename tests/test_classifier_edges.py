@@ -99,7 +99,7 @@ def _engines(frames_mj, link_masses_mj=None, driven_mj=None):
     """A plan and two engines' data that differ only where a test says."""
     from ar3cli.cross_check.measure import EngineData, Plan
 
-    plan = Plan(["j1"], [("home", {"j1": 0.0})], {"j1": 0.0}, {"j1": 0.05})
+    plan = Plan(["j1"], [("home", {"j1": 0.0})], {"j1": 0.0}, {"j1": 0.05}, followers=["j2"])  # j2 follows j1
     pybullet = EngineData("pybullet", ["j1", "j2"], frames=[{"tip": ((20.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))}], mass=1.0,
                           link_masses={"tip": 1e-3}, com=[(0.0, 0.0, 0.0)], driven={"j1": {"j2": 0.0}})
     mujoco = EngineData("mujoco", ["j1", "j2"], frames=[frames_mj], mass=1.0, link_masses=link_masses_mj or {"tip": 1e-3},
@@ -118,8 +118,8 @@ def _disagreeing(tmp_path, **mujoco) -> set[str]:
 
 
 def test_cross_check_tolerance_edges(tmp_path):
-    """Frames at 20 m: 4 float32 epsilons x 20 m; orientations 1e-5 rad; masses 1e-9 kg; a joint moved by the
-    probe: a quarter of the leader's step."""
+    """Frames at 20 m: 4 float32 epsilons x 20 m; orientations 1e-5 rad; masses 1e-9 kg; a follower moved
+    by the probe: a quarter of the leader's step."""
     same = ((20.0, 0.0, 0.0), (0.0, 0.0, 0.0, 1.0))
     allowed = 4 * 2.0 ** -23 * 20.0
 

@@ -151,6 +151,9 @@ def arguments(root: Path) -> dict[str, list[list[str]]]:
         "scan": [[folder, "--store", "scanned.sqlite"]],
         "scan-report": [["store.sqlite", "--keep", "loads", "--keep-list", "keep.txt"]],
         "report": [[one, "-o", "page.html", "-n", "2"]],
+        # expand's stdout without -o is the URDF itself (data, as xacro prints it; XML escapes what XML
+        # must): what is checked here is what it says about the run
+        "expand": [[one, "-o", "expanded.urdf"]],
     }
     for command in COMMANDS:
         if command.startswith("fix-"):

@@ -62,6 +62,6 @@ def _lint(analysis: RobotAnalysis, sim: bool) -> LintAnswer:
         result = settle(unloaded_result(load_failure(analysis.path, shown, message), options), options)
     else:
         result = settle(lint_model(analysis.model, shown, options.rules(), options), options)
-    summary = summarize([result], analysis.settings.fail_on)
+    summary = {**summarize([result], analysis.settings.fail_on), "config_file": options.config_file, "isolated": False}
     summary["exit_code"] = exit_code(summary)
     return LintAnswer(result, summary, lint_json([result], summary), sim)

@@ -75,9 +75,9 @@ GroupOption = Annotated[Optional[bool], typer.Option(
                                "annotation, row, result or test case per rule and file. On by default; JSON keeps "
                                "every finding.", show_default=False, rich_help_panel=CI_PANEL)]
 WideOption = Annotated[bool, typer.Option(
-    "--wide", help="Text format: the table, one line per finding however wide (for wide log viewers). By "
-                   "default tables fit the terminal (or COLUMNS) and wrap messages; piped without COLUMNS "
-                   "(pre-commit, CI logs), each finding is one line: path:line:col: CODE [severity] message.")]
+    "--wide", help="Text format: the table, a row a line however wide. By default tables fit the terminal "
+                   "(or COLUMNS); piped (pre-commit, CI logs), each finding is one line: path:line:col: CODE "
+                   "[severity] message.", rich_help_panel=CI_PANEL)]
 BaselineOption = Annotated[Optional[Path], typer.Option(
     "--baseline", metavar="FILE", help="Do not report (or fail on) the findings this baseline file holds; only new "
                                        "ones count.", show_default=False, rich_help_panel=CI_PANEL)]

@@ -20,6 +20,7 @@ from typing import Any
 from ar3cli.errors import UserError
 from ar3cli.findings import listed
 from ar3cli.info.meshes import MeshFacts, mesh_facts
+from ar3cli.maths.tensor_math import exact_sum
 from ar3cli.urdf.bounds import shape_bounds
 from ar3cli.urdf.model import ACTUATED_JOINT_TYPES, Joint, Link, Model, Shape
 
@@ -146,11 +147,7 @@ class Summary:
     @property
     def total_mass(self) -> float:
         """Sum of the ``<mass>`` values; links without one count 0; inf past the largest float (masses of 1e308 kg)."""
-        masses = [link.mass for link in self.links if link.mass is not None]
-        try:
-            return math.fsum(masses)
-        except OverflowError:  # fsum raises where a plain sum would give inf
-            return math.inf
+        return exact_sum([link.mass for link in self.links if link.mass is not None])
 
     def pybullet_mass(self, fixed_base: bool) -> float:
         """The total mass PyBullet simulates: each link without ``<inertial>`` weighs
@@ -165,7 +162,7 @@ class Summary:
                 masses.append(link.mass)
             elif link.mass_note == NO_INERTIAL and link.name != "world":
                 masses.append(PYBULLET_DEFAULT_MASS)
-        return math.fsum(masses)
+        return exact_sum(masses)
 
     @property
     def massless_links(self) -> list[LinkInfo]:

@@ -154,6 +154,15 @@ def vector_length(parts: Sequence[float]) -> float:
         return math.hypot(*parts)
 
 
+def exact_sum(values: Sequence[float]) -> float:
+    """``math.fsum(values)`` (exactly rounded), but ``inf`` where the sum passes the largest float
+    (masses of 1e308 kg, which a file may hold): fsum raises OverflowError where ``sum`` gives inf."""
+    try:
+        return math.fsum(values)
+    except OverflowError:
+        return math.inf
+
+
 def rpy_to_matrix(rpy: Sequence[float]) -> tuple[tuple[float, float, float], ...]:
     """Rotation matrix (rows) of URDF roll-pitch-yaw: ``Rz(yaw) @ Ry(pitch) @ Rx(roll)``; NaN rows
     for an infinite or NaN angle (which has no rotation: lint's F007 reports the value)."""

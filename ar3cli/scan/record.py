@@ -69,10 +69,12 @@ TIMINGS = ("load_seconds", "check_seconds")
 def model_metrics(model) -> dict[str, Any]:
     """DOF, total mass (the finite ``<mass>`` values summed; None when no link has one), link and
     joint counts of a loaded :class:`~ar3cli.urdf.model.Model`."""
+    from ar3cli.maths.tensor_math import exact_sum
+
     masses = [link.inertial.mass for link in model.links
               if link.inertial is not None and link.inertial.mass is not None and math.isfinite(link.inertial.mass)]
     dof = sum(JOINT_DOF.get(joint.type, 0) for joint in model.joints if joint.mimic is None)
-    return {"dof": dof, "mass": math.fsum(masses) if masses else None, "links": len(model.links),
+    return {"dof": dof, "mass": exact_sum(masses) if masses else None, "links": len(model.links),
             "joints": len(model.joints)}
 
 

@@ -85,46 +85,28 @@ def sim_check(path: Path, settings: AnalysisSettings, encoding: str = "utf-16") 
         dict[str, list[types.Diagnostic]], str | None, list[str]]:
     """``lint-urdf --sim``'s PyBullet findings on the saved ``path``, as diagnostics per file, with
     the one-line error when pybullet could not check it (it crashed or timed out) and log lines."""
-    from ar3cli.analysis.findings import findings
     from ar3cli.analysis.robot import RobotAnalysis
     from ar3cli.lint.rules import REGISTRY
 
     analysis = RobotAnalysis.load(path, settings)
-    error = None
-    try:
-        answer = findings(analysis)
-        found, error, notes = answer.findings, answer.result.error, []
-    except Exception:  # noqa: BLE001 - a broken rule: the others' findings, rule by rule
-        found, notes = lint_findings(analysis, sim=True)
+    found, notes = lint_findings(analysis, sim=True)
+    error, notes = (notes[0], notes[1:]) if notes else (None, [])
     simulated = [finding for finding in found if (rule := REGISTRY.get(finding.rule)) is not None and rule.needs_sim]
     snapshot = Snapshot("", path, None, read_text(path) or "")
     return diagnostics_by_file(simulated, analysis, snapshot, encoding), error, notes
 
 
 def lint_findings(analysis: RobotAnalysis, sim: bool) -> tuple[list[Finding], list[str]]:
-    """The analysis' lint findings (``lint-urdf``, or ``lint-urdf --sim``). When the lint raises
-    (a bug in a rule), the rules run one by one and the one that raises is left out and named."""
+    """The analysis' lint findings (``lint-urdf``, or ``lint-urdf --sim``) and the notes to log. A rule
+    that raises (a bug) costs only its own findings: the engine runs the others and names it in the
+    result's error, which becomes a note here; anything else that fails is one note, no findings."""
     from ar3cli.analysis.findings import findings, static_findings
 
     try:
-        return list((findings if sim else static_findings)(analysis).findings), []
-    except Exception as exc:  # noqa: BLE001 - one broken rule must not hide the others' findings
-        first = f"{type(exc).__name__}: {exc}"
-    if analysis.model is None:
-        return [], [f"{analysis.path}: the check failed ({first})"]
-    from ar3cli.lint.engine import lint_model
-
-    options = analysis.settings.lint_options(sim)
-    found: list[Finding] = []
-    notes = [f"{analysis.path}: the lint failed ({first}); running its rules one by one"]
-    for rule in options.rules():
-        try:
-            found += lint_model(analysis.model, analysis.shown_path, [rule], options).findings
-        except Exception as exc:  # noqa: BLE001 - see above
-            notes.append(f"{analysis.path}: rule {rule.code} failed ({type(exc).__name__}: {exc}); "
-                         "its findings are missing (a bug in ar3cli: please report it)")
-    found.sort(key=lambda f: (f.path != analysis.shown_path, f.path, f.line, f.column, f.rule))
-    return found, notes
+        answer = (findings if sim else static_findings)(analysis)
+    except Exception as exc:  # noqa: BLE001 - one bad file must not stop the server
+        return [], [f"{analysis.path}: the check failed ({type(exc).__name__}: {exc})"]
+    return list(answer.findings), [answer.result.error] if answer.result.error else []
 
 
 def is_macro_library(analysis: RobotAnalysis) -> bool:

@@ -511,7 +511,7 @@ def world_inertial(ctx) -> Iterator[Hit]:
           "from the geometry); if it is always fixed to the world, nothing to do.",
       bad=robot('''<link name="chassis"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
       good=robot(f'''<link name="chassis">{LINK_INERTIAL}<collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
-      thresholds="Skipped: a root named world (PyBullet gives it mass 0), and a root without geometry that "
+      thresholds="Skipped: a root named world (PyBullet gives it no mass), and a root without geometry that "
                  "is not joined to the rest by fixed joints only (an arm's mounting frame).",
       references="PyBullet UrdfParser.cpp parseLink (mass 1, inertia 1 without <inertial>); Drake "
                  "multibody/parsing/detail_urdf_parser.cc ParseBody (no <inertial>: zero spatial inertia).")
