@@ -66,6 +66,7 @@ COMMANDS: dict[str, str] = {
     "scan": "ar3cli.commands.scan:scan",
     "scan-report": "ar3cli.commands.scan_report:scan_report",
     "report": "ar3cli.commands.report:report",
+    "view": "ar3cli.commands.view:view",
 }
 """Every command, in the order ``--help`` lists them, and where its function (or its fixer) is. A
 run imports only the module of the command it runs (see :func:`application`)."""

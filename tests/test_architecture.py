@@ -20,6 +20,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("entry point", ["__main__"]),
     ("application", ["cli"]),
     ("commands", ["commands"]),
+    ("front-ends", ["view"]),
     ("analysis", ["analysis"]),
     ("fixers", ["fix"]),
     ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "install_check", "info", "robot_diff", "scan",

@@ -16,10 +16,10 @@ from tests.conftest import REPO
 IMPORT_DISTRIBUTIONS = {"PIL": "pillow", "yaml": "pyyaml", "pybullet_data": "pybullet", "collada": "pycollada"}
 """Import names whose distribution has another name; any other import is its own distribution."""
 
-GUARDED = {"coacd": "decompose", "mujoco": "mujoco", "ray": "ray", "tomli": None, "click": None}
-"""Imports that may be absent: coacd, mujoco and ray belong to extras (fix-collision checks
-``find_spec`` first; ``--engine mujoco``, cross-check and ``scan --backend ray`` say in one line how
-to install them), tomli is declared for Python < 3.11 only (``tomllib`` is used where it exists),
+GUARDED = {"coacd": "decompose", "mujoco": "mujoco", "ray": "ray", "viser": "view", "tomli": None, "click": None}
+"""Imports that may be absent: coacd, mujoco, ray and viser belong to extras (fix-collision checks
+``find_spec`` first; ``--engine mujoco``, cross-check, ``scan --backend ray`` and ``view`` say in one
+line how to install them), tomli is declared for Python < 3.11 only (``tomllib`` is used where it exists),
 click is the fallback of options.py for a typer that does not vendor it (typer then depends on it)."""
 
 
