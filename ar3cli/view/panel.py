@@ -83,6 +83,49 @@ class Panel:
                 slider.value = value
 
 
+class Banners:
+    """Notifications on every open page, and on each page that opens later, while something is wrong
+    (the file does not load, pybullet crashed): seen wherever the panel is scrolled. One per topic;
+    the text is plain (viser shows a notification's body as text), one line, shortened."""
+
+    def __init__(self, server: Any) -> None:
+        import threading
+
+        self.server = server
+        self._lock = threading.Lock()
+        self.shown: dict[str, tuple[str, str]] = {}
+        self._handles: dict[str, list[Any]] = {}
+        server.on_client_connect(self._connected)
+
+    def show(self, topic: str, title: str, body: str) -> None:
+        """Show (or replace) the banner of ``topic`` on every page."""
+        text = (label(title, 120), label(body, 600))
+        with self._lock:
+            if self.shown.get(topic) == text:
+                return
+            self._remove(topic)
+            self.shown[topic] = text
+            self._handles[topic] = [self._add(client, *text) for client in self.server.get_clients().values()]
+
+    def clear(self, topic: str) -> None:
+        with self._lock:
+            self.shown.pop(topic, None)
+            self._remove(topic)
+
+    def _remove(self, topic: str) -> None:
+        for handle in self._handles.pop(topic, []):
+            handle.remove()
+
+    def _connected(self, client: Any) -> None:
+        with self._lock:
+            for topic, text in self.shown.items():
+                self._handles.setdefault(topic, []).append(self._add(client, *text))
+
+    @staticmethod
+    def _add(client: Any, title: str, body: str) -> Any:
+        return client.add_notification(title, body, with_close_button=True, color="red")
+
+
 def slider_step(control: JointControl) -> float:
     """The power of ten nearest to the range / :data:`SLIDER_STEPS` (a zero range: 1e-6)."""
     span = control.upper - control.lower

@@ -52,7 +52,7 @@ class Viewer:
         import numpy as np
 
         from ar3cli.output.report import log as stderr_log
-        from ar3cli.view.panel import Panel
+        from ar3cli.view.panel import Banners, Panel
 
         self.server = server
         self.log = log or stderr_log
@@ -77,6 +77,7 @@ class Viewer:
         """Loads drawn (the first one and every reload that loaded)."""
         self._lint_threads: list[threading.Thread] = []
         self.panel = Panel(server.gui, self.layers, self._layers_changed, self.home, self.random_pose, seed)
+        self.banners = Banners(server)
         self.worker = ContactWorker(self._contacts_found)
         self.worker.start()
         self.load(analysis)
@@ -116,6 +117,8 @@ class Viewer:
             previous, self.latest = self.latest, analysis
             self.load_error = message
             self._refresh_status()
+            kept = "the last good robot stays on screen" if self.shown is not None else "nothing to show yet"
+            self.banners.show("load", f"{self.path_shown} does not load ({kept})", message)
         if previous is not self.shown and previous is not analysis:
             previous.close()  # a failed load holds no pybullet child: closing it here is safe
 
@@ -145,6 +148,8 @@ class Viewer:
             self.loads += 1
             self.load_error = self.contact_error = self.lint_error = None
             self.contacts = None
+            self.banners.clear("load")
+            self.banners.clear("contacts")
             self._set_findings(placed, lint.summary, simulated=False)
             self.scene.pose(self.values)
             self.panel.set_controls(posed, self.values, self._slider_moved)
@@ -246,6 +251,8 @@ class Viewer:
                 return
             self.contacts, self.contact_error = found, error
             self.scene.colour(contacts=found.links() if found is not None else set())
+            if error is not None:
+                self.banners.show("contacts", "Contacts not checked", error)
             self._refresh_status()
             self._refresh_selected()
         if home and error is not None:
