@@ -348,6 +348,44 @@ def test_random_poses_follow_the_seed(tmp_path, viser_server):
     assert poses[0] == poses[1] and -2 <= poses[0]["shoulder"] <= 2
 
 
+FORK_WHILE_WRITING = """
+import io, os, sys, threading, time
+from ar3cli.view.streams import fork_safe_streams
+read_end, write_end = os.pipe()
+sys.stderr = io.TextIOWrapper(io.BufferedWriter(io.FileIO(write_end, "w")))
+with fork_safe_streams():
+    threading.Thread(target=lambda: sys.stderr.write("x" * (1 << 20)), daemon=True).start()
+    time.sleep(0.3)  # that thread is inside its write now: the pipe holds 64 KB
+    threading.Thread(target=lambda: (time.sleep(0.5), [os.read(read_end, 1 << 16) for _ in range(16)]),
+                     daemon=True).start()
+    pid = os.fork()
+    if pid == 0:
+        sys.stderr.flush()  # what every pybullet child does first (sim.capture.capture_fds)
+        os._exit(0)
+    for _ in range(50):
+        if os.waitpid(pid, os.WNOHANG)[0]:
+            print("ended", file=sys.__stdout__)
+            break
+        time.sleep(0.1)
+    else:
+        os.kill(pid, 9)
+        print("hung", file=sys.__stdout__)
+os._exit(0)
+"""
+
+
+def test_a_child_forked_while_another_thread_writes_can_still_write():
+    """The viewer forks pybullet children while its threads write to stderr: a child forked in the middle
+    of a write inherited stderr's lock locked and waited forever (the simulated lint timed out after
+    120 s). With the streams guarded, the fork waits for the write and the child flushes at once."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-c", FORK_WHILE_WRITING], capture_output=True, text=True, timeout=60,
+                          env={**os.environ, "PYTHONPATH": str(REPO)})
+    assert done.stdout.strip() == "ended", done.stdout + done.stderr
+
+
 # ---- texts and the command ---------------------------------------------------------------------
 
 def test_robot_strings_cannot_become_markup():

@@ -19,10 +19,6 @@ import importlib.util
 import os
 import re
 import shutil
-import signal
-import subprocess
-import sys
-import threading
 import time
 from pathlib import Path
 
@@ -30,6 +26,7 @@ import pytest
 
 from tests.chromium import CHROMIUM, Chromium, difference, robot_pixels
 from tests.conftest import REPO
+from tests.view_process import WAIT_SECONDS, ViewerProcess, running
 
 pytestmark = [
     pytest.mark.skipif(CHROMIUM is None, reason="headless Chromium is not installed (apt-get install chromium; "
@@ -38,8 +35,6 @@ pytestmark = [
                        reason="viser is not installed (pip install 'ar3cli[view]')"),
 ]
 
-WAIT_SECONDS = 90.0
-"""The longest any one step may take (a loaded 2-core CI machine renders WebGL in software)."""
 DRAWN = 0.02
 """Share of the middle of the canvas that must differ from the background: the robot is drawn."""
 MOVED = 1.0
@@ -47,54 +42,6 @@ MOVED = 1.0
 CANVAS = (0.3, 0.2, 0.64, 0.92)
 """Where the robot is (fractions of the page: left, top, right, bottom): the canvas's middle, clear of
 viser's panel on the right and of its notifications on the top left."""
-
-
-class Viewer:
-    """``ar3cli view ROBOT --port 0`` as a process; its stderr lines collected as they come."""
-
-    def __init__(self, robot: Path, temporary: Path) -> None:
-        env = {**os.environ, "PYTHONPATH": str(REPO), "NO_COLOR": "1", "TMPDIR": str(temporary)}
-        self.process = subprocess.Popen([sys.executable, "-m", "ar3cli", "view", str(robot), "--port", "0"],
-                                        cwd=robot.parent, env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE,
-                                        stderr=subprocess.PIPE, text=True)
-        self.lines: list[str] = []
-        self._reader = threading.Thread(target=self._read, daemon=True)
-        self._reader.start()
-        found: list[str] = []
-        stdout = threading.Thread(target=lambda: found.append(self.process.stdout.readline()), daemon=True)
-        stdout.start()
-        stdout.join(WAIT_SECONDS)
-        match = re.search(r"http://\S+/", found[0] if found else "")
-        assert match, f"no URL printed; stderr: {self.lines}"
-        self.url = match.group()
-
-    def _read(self) -> None:
-        for line in self.process.stderr:
-            self.lines.append(line.rstrip("\n"))
-
-    def wait_for(self, text: str, after: int = 0) -> str:
-        """The first stderr line from number ``after`` on that holds ``text``."""
-        deadline = time.monotonic() + WAIT_SECONDS
-        while time.monotonic() < deadline:
-            for line in self.lines[after:]:
-                if text in line:
-                    return line
-            time.sleep(0.05)
-        raise AssertionError(f"no stderr line with {text!r}: {self.lines}")
-
-    def children(self) -> list[int]:
-        found: list[int] = []
-        for task in Path(f"/proc/{self.process.pid}/task").glob("*"):
-            try:
-                found += [int(pid) for pid in (task / "children").read_text().split()]
-            except OSError:
-                continue
-        return found
-
-    def stop(self) -> None:
-        if self.process.poll() is None:
-            self.process.kill()
-            self.process.wait()
 
 
 def _kept(name: str, image):
@@ -117,15 +64,6 @@ def _a_robot_pixel(image) -> tuple[float, float]:
     centre = np.median(drawn, axis=0)
     row, column = drawn[np.argmin(((drawn - centre) ** 2).sum(axis=1))]
     return float(left + column), float(top + row)
-
-
-def _running(pid: int) -> bool:
-    """Whether process ``pid`` still runs (a zombie waiting for a reaper that never comes does not)."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rpartition(")")[2].split()[0]
-    except (OSError, IndexError):
-        return False
-    return state not in ("Z", "X")
 
 
 def _until(condition, what: str):
@@ -169,7 +107,7 @@ def robot(tmp_path, pybullet_data_dir) -> Path:
 def test_the_viewer_draws_moves_reloads_and_stops_clean(robot, tmp_path, browser):
     temporary = tmp_path / "tmp"
     temporary.mkdir()
-    viewer = Viewer(robot, temporary)
+    viewer = ViewerProcess(robot, temporary)
     try:
         viewer.wait_for("contacts at home: 0 pair(s)")
         browser.new_page()
@@ -232,10 +170,9 @@ def test_the_viewer_draws_moves_reloads_and_stops_clean(robot, tmp_path, browser
 
         children = viewer.children()
         assert children, "the contact checker's pybullet child should be running"
-        viewer.process.send_signal(signal.SIGTERM)
-        assert viewer.process.wait(WAIT_SECONDS) == 143
+        assert viewer.terminate() == 143
         viewer.wait_for("ar3cli: terminated")
-        assert [pid for pid in children if _running(pid)] == []
+        assert [pid for pid in children if running(pid)] == []
         assert list(temporary.iterdir()) == []
     finally:
         viewer.stop()

@@ -98,14 +98,24 @@ def _refuse_share(*_args: object, **_kwargs: object) -> None:
 def serve(path: Path, settings: Any, host: str, port: int | None, seed: int, open_browser: bool,
           announce: Callable[[str], None], log: Callable[[str], None]) -> None:
     """Load ``path``, draw it, call ``announce(url)`` and redraw it as it changes, until interrupted;
-    ``log`` gets the progress lines (what was drawn, the findings, the contacts at home)."""
+    ``log`` gets the progress lines (what was drawn, the findings, the contacts at home). The standard
+    streams are fork-safe meanwhile (:mod:`ar3cli.view.streams`): pybullet children are forked while
+    other threads write."""
+    from ar3cli.view.streams import fork_safe_streams
+
+    import_viser()
+    with fork_safe_streams():
+        _serve(path, settings, host, port, seed, open_browser, announce, log)
+
+
+def _serve(path: Path, settings: Any, host: str, port: int | None, seed: int, open_browser: bool,
+           announce: Callable[[str], None], log: Callable[[str], None]) -> None:
     from ar3cli.analysis.robot import RobotAnalysis
     from ar3cli.view.viewer import POLL_SECONDS, Viewer
 
-    import_viser()
     if not is_local(host):
         log(f"warning: listening on {host}: whoever can reach this address sees the robot, its mesh geometry, its "
-             "names and the findings; bind 127.0.0.1 (the default) to keep them on this machine")
+            "names and the findings; bind 127.0.0.1 (the default) to keep them on this machine")
     analysis = RobotAnalysis.load(path, settings)
     server = start_server(host, port)
     viewer = None

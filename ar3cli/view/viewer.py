@@ -179,8 +179,11 @@ class Viewer:
             self.lint_error = answer.result.error
             self._set_findings(placed, answer.summary, simulated=True)
             self._refresh_status()
-        note = f"; simulated checks not run: {answer.result.error}" if answer.result.error else ""
-        self.log(f"{self.path_shown}: lint with the simulated checks: {describe.counted(answer.summary)}{note}")
+        if answer.result.error:
+            self.log(f"{self.path_shown}: lint: {describe.counted(answer.summary)} (the simulated checks did not run: "
+                     f"{answer.result.error})")
+        else:
+            self.log(f"{self.path_shown}: lint with the simulated checks: {describe.counted(answer.summary)}")
 
     def _set_findings(self, placed, summary: Mapping[str, Any], simulated: bool) -> None:
         """(Under the lock) the findings on the links, in the panel and in the colours."""
