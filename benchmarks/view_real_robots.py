@@ -97,7 +97,9 @@ def view_one(browser: Chromium, name: str, path: Path, wait: float, shots: Path 
                 previous = image
                 time.sleep(0.3)
             if shots is not None and image is not None:
-                image.save(shots / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png")
+                browser.evaluate("document.querySelectorAll('.mantine-Notification-closeButton').forEach(b => b.click())")
+                time.sleep(0.5)  # the notification slides out
+                browser.image().save(shots / f"{re.sub(r'[^A-Za-z0-9_.-]+', '_', name)}.png", optimize=True)
             contacts = viewer.wait_for("contacts")
             found = re.search(r"contacts at home: (\d+) pair", contacts)
             row["contacts"] = found.group(1) if found else contacts.partition("contacts ")[2][:60]

@@ -28,6 +28,10 @@ DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 8080
 """viser's own default; taken, the next free port is used."""
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
+SHADOWS = False
+"""Lights cast no shadows: a robot's links lie on and in each other, and the self-shadowing striped
+every curved surface (shadow acne, in SwiftShader and on GPUs alike) without showing anything ar3cli
+knows; the viewer is about geometry and findings, not looks."""
 ENVIRONMENT_MAP = None
 """viser lights its scene with an HDR environment map by default; without a GPU (a browser's software
 WebGL, headless Chromium's SwiftShader) preparing it held the first picture of the page for 23-26 s
@@ -88,6 +92,7 @@ def start_server(host: str, port: int | None) -> Any:
     server = viser.ViserServer(host=host, port=wanted, verbose=False)
     server.request_share_url = _refuse_share  # the client's share button would tunnel the page to the internet
     server.scene.configure_environment_map(hdri=ENVIRONMENT_MAP)
+    server.scene.configure_default_lights(cast_shadow=SHADOWS)
     return server
 
 
