@@ -332,6 +332,39 @@ def test_a_reload_keeps_sliders_by_name_and_a_broken_file_keeps_the_last_good_ro
         viewer.close()
 
 
+def test_an_included_xacro_or_a_mesh_that_changes_is_redrawn(tmp_path, viser_server):
+    """Live reload sees more than the robot file: the xacro file it includes, and a mesh."""
+    import shutil
+
+    from ar3cli.analysis.inertia_boxes import inertia_boxes as boxes_of
+    from ar3cli.view.viewer import Viewer
+    from tests.test_fix_collision import U_CELLS, voxel_mesh
+
+    shutil.copytree(REPO / "tests" / "data" / "xacro", tmp_path / "xacro")
+    macros = tmp_path / "xacro" / "macros" / "arm_segment.xacro"
+    voxel_mesh(U_CELLS).export(str(tmp_path / "xacro" / "u.stl"))
+    top = tmp_path / "xacro" / "arm.urdf.xacro"
+    top.write_text(top.read_text().replace('<link name="wrist_link"/>', '<link name="wrist_link"><visual><geometry>'
+                                           '<mesh filename="u.stl"/></geometry></visual></link>'), encoding="utf-8")
+    lines: list[str] = []
+    viewer = Viewer(viser_server, RobotAnalysis.load(top), log=lines.append)
+    try:
+        def mass(link: str) -> float:
+            return next(box.mass for box in boxes_of(viewer.shown) if box.link == link)
+
+        def width() -> float:
+            return float(np.ptp(link_meshes(viewer.shown).of("wrist_link")[0].vertices[:, 0]))
+
+        assert mass("shoulder_link") == 0.5 and width() == pytest.approx(0.07)
+        macros.write_text(macros.read_text().replace('value="0.5"', 'value="0.75"'), encoding="utf-8")
+        assert viewer.poll() and mass("shoulder_link") == 0.75 and "arm_segment.xacro changed" in lines[-1]
+        voxel_mesh([(x, 0, 0) for x in range(10)]).export(str(tmp_path / "xacro" / "u.stl"))
+        assert viewer.poll() and width() == pytest.approx(0.1) and "u.stl changed" in lines[-1]
+        assert "inertia" in viewer.scene.links["shoulder_link"].extras
+    finally:
+        viewer.close()
+
+
 def test_random_poses_follow_the_seed(tmp_path, viser_server):
     from ar3cli.view.viewer import Viewer
 
