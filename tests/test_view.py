@@ -460,3 +460,31 @@ def test_view_refuses_a_missing_file_and_a_busy_port(tmp_path):
     done = run_cli("view", str(robot), "--host", "192.0.2.1")  # TEST-NET-1: never this machine's
     assert done.code == 2 and "192.0.2.1 port 8080 cannot be listened on" in done.stderr, done.stderr
     assert "warning: listening on 192.0.2.1" in done.stderr
+
+
+def test_json_output_is_the_url_document_alone(tmp_path):
+    """``--format json``: stdout holds ``{"url", "path"}`` alone, printed once the robot is drawn."""
+    pytest.importorskip("viser")
+    import json
+    import subprocess
+    import sys
+
+    robot = _contact_robot(tmp_path / "r.urdf")
+    process = subprocess.Popen([sys.executable, "-m", "ar3cli", "view", str(robot), "--port", "0", "--format", "json"],
+                               env={**os.environ, "PYTHONPATH": str(REPO)}, stdout=subprocess.PIPE,
+                               stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True)
+    try:
+        text = ""
+        while not text.rstrip().endswith("}"):
+            line = process.stdout.readline()
+            assert line, "stdout ended without a JSON document"
+            text += line
+        document = json.loads(text)
+        assert set(document) == {"url", "path"} and document["path"] == str(robot)
+        assert document["url"].startswith("http://127.0.0.1:")
+        process.send_signal(signal.SIGTERM)
+        assert process.wait(60) == 143 and process.stdout.read() == ""
+    finally:
+        if process.poll() is None:
+            process.kill()
+            process.wait()
