@@ -119,7 +119,8 @@ class Chromium:
         return Image.open(io.BytesIO(self.screenshot())).convert("RGB")
 
     def click(self, x: float, y: float) -> None:
-        """A left click at (``x``, ``y``) CSS pixels."""
+        """A left click at (``x``, ``y``) CSS pixels (the pointer moved there first, as a hand would)."""
+        self.call("Input.dispatchMouseEvent", type="mouseMoved", x=x, y=y)
         for kind in ("mousePressed", "mouseReleased"):
             self.call("Input.dispatchMouseEvent", type=kind, x=x, y=y, button="left", clickCount=1)
 
