@@ -9,7 +9,13 @@ and a stop that leaves nothing behind.
 - viser's client has a "share" button that asks the server to open a public tunnel to the page;
   the button is hidden and the server refuses the request: a robot file under review stays local.
 - Ctrl-C and SIGTERM (a KeyboardInterrupt in this thread, :mod:`ar3cli.infra.shutdown`) end the
-  loop; the viewer then closes its pybullet children and the server stops.
+  loop; the viewer then closes its pybullet children and the server stops. trimesh catches
+  ``BaseException`` in places (its optional imports, some of its methods): a SIGTERM raised while
+  trimesh runs can be swallowed, and only the first SIGTERM is raised (a second one must not cut a
+  cleanup short). Measured: a SIGTERM 1.2 s after the start, during ``import trimesh`` with viser's
+  threads running, left the viewer running and deaf to every later SIGTERM. So the loop checks
+  :func:`ar3cli.infra.shutdown.received` and raises the SIGTERM itself, and the first meshes are
+  read before viser starts its threads (:func:`prepare`).
 """
 
 from __future__ import annotations
@@ -96,6 +102,26 @@ def start_server(host: str, port: int | None) -> Any:
     return server
 
 
+def prepare(analysis: Any) -> None:
+    """Answer what the first draw needs (meshes, poses, inertia boxes, the static lint) before any
+    thread starts: importing trimesh and scipy takes seconds, and only in a process with one thread
+    does :func:`ar3cli.infra.held_import.import_holding_interrupts` hold a Ctrl-C or a SIGTERM until
+    the import is done (with other threads, the signal reaches one of them and Python raises it in
+    the main thread anyway). A file that does not load has nothing to prepare."""
+    from ar3cli.analysis.findings import static_findings
+    from ar3cli.analysis.inertia_boxes import inertia_boxes
+    from ar3cli.analysis.meshes import link_meshes
+    from ar3cli.analysis.poses import posing
+
+    if analysis.model is None:
+        return
+    for question in (link_meshes, posing, inertia_boxes, static_findings):
+        try:
+            question(analysis)
+        except UserError:
+            return  # the viewer says why when it draws
+
+
 def _refuse_share(*_args: object, **_kwargs: object) -> None:
     return None
 
@@ -116,12 +142,14 @@ def serve(path: Path, settings: Any, host: str, port: int | None, seed: int, ope
 def _serve(path: Path, settings: Any, host: str, port: int | None, seed: int, open_browser: bool,
            announce: Callable[[str], None], log: Callable[[str], None]) -> None:
     from ar3cli.analysis.robot import RobotAnalysis
+    from ar3cli.infra import shutdown
     from ar3cli.view.viewer import POLL_SECONDS, Viewer
 
     if not is_local(host):
         log(f"warning: listening on {host}: whoever can reach this address sees the robot, its mesh geometry, its "
             "names and the findings; bind 127.0.0.1 (the default) to keep them on this machine")
     analysis = RobotAnalysis.load(path, settings)
+    prepare(analysis)  # the heavy imports and the first meshes while this process has one thread
     server = start_server(host, port)
     viewer = None
     try:
@@ -134,6 +162,8 @@ def _serve(path: Path, settings: Any, host: str, port: int | None, seed: int, op
             webbrowser.open(url)
         while True:
             time.sleep(POLL_SECONDS)
+            if shutdown.received():
+                raise shutdown.Terminated  # a SIGTERM that library code swallowed (see the docstring)
             viewer.poll()
     finally:
         if viewer is not None:

@@ -51,13 +51,19 @@ class _Guarded:
         return getattr(self._stream, name)
 
 
+_forking = threading.local()
+"""Whether this thread took the lock for the fork it is making (released after it, in both processes)."""
+
+
 def _before_fork() -> None:
     if _active:
         _LOCK.acquire()
+        _forking.held = True
 
 
 def _after_fork() -> None:
-    if _active and _LOCK.locked():
+    if getattr(_forking, "held", False):
+        _forking.held = False
         _LOCK.release()
 
 

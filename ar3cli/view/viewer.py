@@ -2,18 +2,19 @@
 
 :class:`Viewer` holds what is on screen: the last analysis that loaded (``shown``), the last load
 (``latest``, which may have failed), the joint values by name, the scene and the panel. Work happens
-on four kinds of threads, and every change of that state takes the viewer's lock:
+on three kinds of threads, and every change of that state takes the viewer's lock:
 
 - the main thread polls the files the load depended on (:meth:`Viewer.poll`, every
   :data:`POLL_SECONDS`) and reloads: the new robot is drawn with the slider values kept by joint name,
-  or, when it does not load, the last good robot stays on screen with the error in the status;
+  or, when it does not load, the last good robot stays on screen with the error in the status. After
+  each load it runs the simulated lint (``lint-urdf --sim``'s P rules, in a pybullet child, 1-3 s on
+  the largest robots) and replaces the static findings with the full set: there, Ctrl-C and SIGTERM
+  stop that child and remove its folder as in every command;
 - viser's threads run the panel's callbacks (sliders, buttons, check boxes, clicks);
 - the contact worker (:class:`ContactWorker`) answers "which links touch now?" through each
   analysis's kept pybullet child, the latest pose first (slider moves in between are skipped), and
   closes the analyses no longer shown (so a child is never closed while it answers); it is the
-  thread that forks those children, and lives as long as they do;
-- a short thread per load runs the simulated lint (``lint-urdf --sim``'s P rules, in a pybullet
-  child) and then replaces the static findings with the full set.
+  thread that forks those children, and lives as long as they do.
 
 A pybullet crash or a load that fails is a line in the status, never the end of the viewer.
 """
@@ -39,9 +40,6 @@ POLL_SECONDS = 0.25
 """How often the files are checked for changes (a ``stat`` each): a save is seen within this."""
 SETTLE_SECONDS = 0.1
 """Wait after a change is seen before reading: an editor's save can be several writes."""
-LINT_JOIN_SECONDS = 10.0
-"""On closing, how long a simulated lint still running may take to finish and remove its child's
-folder (Ctrl-C reaches that child too and ends it at once; it takes 1-3 s on the largest robots)."""
 
 
 class Viewer:
@@ -75,7 +73,8 @@ class Viewer:
         self.selected: str | None = None
         self.loads = 0
         """Loads drawn (the first one and every reload that loaded)."""
-        self._lint_threads: list[threading.Thread] = []
+        self._unlinted: RobotAnalysis | None = None
+        """A load drawn with its static findings only: the next :meth:`poll` runs the simulated lint."""
         self.panel = Panel(server.gui, self.layers, self._layers_changed, self.home, self.random_pose, seed)
         self.banners = Banners(server)
         self.worker = ContactWorker(self._contacts_found)
@@ -84,7 +83,11 @@ class Viewer:
 
     # ---- loading ------------------------------------------------------------------------------
     def poll(self) -> bool:
-        """Reload when a file the last load depended on changed; True when it did."""
+        """Run the simulated lint of the load just drawn, if any; then reload when a file the last load
+        depended on changed (True when it did)."""
+        unlinted, self._unlinted = self._unlinted, None
+        if unlinted is not None:
+            self._simulated_lint(unlinted)
         changed = self.latest.changed()
         if not changed:
             return False
@@ -158,19 +161,17 @@ class Viewer:
             self._ask_contacts(home=True)
         for retired in {previous, old} - {analysis, None}:
             self.worker.retire(retired)  # type: ignore[arg-type]
-        thread = threading.Thread(target=self._simulated_lint, args=(analysis,), name="ar3cli-view-lint", daemon=True)
-        self._lint_threads = [t for t in self._lint_threads if t.is_alive()] + [thread]
-        thread.start()
+        self._unlinted = analysis
         return time.perf_counter() - start
 
     def _simulated_lint(self, analysis: RobotAnalysis) -> None:
-        """In its own thread: the static and the PyBullet rules, then the panel and colours updated."""
+        """The static and the PyBullet rules, then the panel and the colours updated."""
         from ar3cli.analysis.findings import findings
         from ar3cli.analysis.link_findings import place_findings
 
         try:
             answer = findings(analysis)
-        except (UserError, KeyboardInterrupt):
+        except UserError:
             return
         placed = place_findings(analysis, answer.findings)
         with self._lock:
@@ -293,15 +294,12 @@ class Viewer:
 
     # ---- the end ------------------------------------------------------------------------------
     def close(self) -> None:
-        """Stop the worker (closing every pybullet child it opened) and let running lints finish."""
+        """Stop the worker, closing every pybullet child it opened."""
         self.worker.stop()
         with self._lock:
             analyses = {self.shown, self.latest} - {None}
         for analysis in analyses:
             analysis.close()  # type: ignore[union-attr]
-        deadline = time.monotonic() + LINT_JOIN_SECONDS
-        for thread in self._lint_threads:
-            thread.join(max(0.0, deadline - time.monotonic()))
 
 
 class ContactWorker(threading.Thread):
