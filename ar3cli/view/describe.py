@@ -21,8 +21,8 @@ if TYPE_CHECKING:
 
 FINDINGS_SHOWN = 60
 """Findings the panel lists before it counts the rest (the terminal has them all: ar3cli lint-urdf)."""
-PAIRS_SHOWN = 12
-"""Pairs in contact named in the status before the rest are counted."""
+PAIRS_SHOWN = 6
+"""Pairs in contact named in the status before the rest are counted (a click on a link names all of its own)."""
 SEVERITY_NAMES = {Severity.ERROR: "error", Severity.WARNING: "warning", Severity.INFO: "info"}
 
 
