@@ -119,6 +119,16 @@ def needs(text: str):
     return lambda result: None if text in result.stdout + result.stderr else f"output lacks {text!r}"
 
 
+def one_line(text: str):
+    """A check: the output is one line on stderr, holding ``text`` (nothing on stdout)."""
+    def check(result: subprocess.CompletedProcess) -> str | None:
+        lines = result.stderr.strip().splitlines()
+        if result.stdout.strip() or len(lines) != 1 or text not in lines[0]:
+            return f"expected one stderr line with {text!r}"
+        return None
+    return check
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ar3cli", type=Path, default=Path(sys.executable).parent / "ar3cli",
@@ -170,9 +180,8 @@ def steps(smoke: Smoke, work: Path) -> None:
     for name, args in (("cross-check (no mujoco)", ["cross-check", str(robot)]),
                        ("lint-urdf --engine mujoco (no mujoco)", ["lint-urdf", "--sim", "--engine", "mujoco", str(robot)])):
         smoke.run(name, args, expect=(2,), check=needs("pip install 'ar3cli[mujoco]'"))
-    smoke.run("server (no pygls)", ["server"], expect=(2,),
-              check=lambda r: None if "pip install 'ar3cli[server]'" in r.stderr and len(r.stderr.splitlines()) == 1
-              and not r.stdout else "not one line naming pip install 'ar3cli[server]'")
+    smoke.run("server (no pygls)", ["server"], expect=(2,), check=one_line("pip install 'ar3cli[server]'"))
+    smoke.run("view (no viser)", ["view", str(robot)], expect=(2,), check=one_line("pip install 'ar3cli[view]'"))
 
     def fixed_copy(name: str) -> Path:
         return make_robot(work / name)

@@ -68,6 +68,7 @@ COMMANDS: dict[str, str] = {
     "scan-report": "ar3cli.commands.scan_report:scan_report",
     "report": "ar3cli.commands.report:report",
     "server": "ar3cli.commands.server:server",
+    "view": "ar3cli.commands.view:view",
 }
 """Every command, in the order ``--help`` lists them, and where its function (or its fixer) is. A
 run imports only the module of the command it runs (see :func:`application`)."""

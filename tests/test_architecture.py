@@ -20,7 +20,7 @@ LAYERS: list[tuple[str, list[str]]] = [
     ("entry point", ["__main__"]),
     ("application", ["cli"]),
     ("commands", ["commands"]),
-    ("front-ends", ["server"]),
+    ("front-ends", ["server", "view"]),
     ("analysis", ["analysis"]),
     ("fixers", ["fix"]),
     ("features", ["lint", "collisions", "kinematics", "pictures", "grasp", "install_check", "info", "robot_diff", "scan",

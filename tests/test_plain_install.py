@@ -17,10 +17,10 @@ IMPORT_DISTRIBUTIONS = {"PIL": "pillow", "yaml": "pyyaml", "pybullet_data": "pyb
 """Import names whose distribution has another name; any other import is its own distribution."""
 
 GUARDED = {"coacd": "decompose", "mujoco": "mujoco", "ray": "ray", "pygls": "server", "lsprotocol": "server",
-           "tomli": None, "click": None}
-"""Imports that may be absent: coacd, mujoco, ray, pygls and lsprotocol belong to extras (fix-collision checks
-``find_spec`` first; ``--engine mujoco``, cross-check, ``scan --backend ray`` and ``server`` say in one line how
-to install them), tomli is declared for Python < 3.11 only (``tomllib`` is used where it exists),
+           "viser": "view", "tomli": None, "click": None}
+"""Imports that may be absent: coacd, mujoco, ray, pygls, lsprotocol and viser belong to extras (fix-collision
+checks ``find_spec`` first; ``--engine mujoco``, cross-check, ``scan --backend ray``, ``server`` and ``view``
+say in one line how to install them), tomli is declared for Python < 3.11 only (``tomllib`` is used where it exists),
 click is the fallback of options.py for a typer that does not vendor it (typer then depends on it)."""
 
 
