@@ -170,6 +170,7 @@ NO_ROBOT_INPUT = {
 """Commands that read no robot file (no argument): nothing of an attacker's reaches their output."""
 FRONT_ENDS = {
     "server": ("tests/test_server.py", "test_hostile_names_reach_the_editor_as_plain_text"),
+    "view": ("tests/test_view.py", "test_the_panel_shows_a_hostile_robot_s_names_as_text"),
 }
 """Commands without ``--format`` that read robot files another way (an editor's buffers over LSP, a
 browser): the test named here walks their output with the same hostile names."""

@@ -226,12 +226,16 @@ def test_a_pybullet_crash_is_one_line_and_stays(tmp_path):
     analysis.close()
 
 
-def test_a_robot_pybullet_cannot_load_is_an_error_not_a_hang(tmp_path):
+def test_a_link_whose_mesh_is_missing_is_left_out_and_named(tmp_path):
+    """One missing mesh stops nothing (issue 36 item 3): the other links are checked, the note names it."""
     path = _robot(tmp_path / "r.urdf", _link("a", collision=_collision("0.1 0.1 0.1")),
                   _link("b", collision='<collision><geometry><mesh filename="missing.stl"/></geometry></collision>'),
                   '<joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>')
-    with pytest.raises(UserError, match="missing.stl"):
-        contacts(_analysed(path), {})
+    found = contacts(_analysed(path), {})
+    assert found.pairs == [] and found.unchecked == ["b"] and found.note is None
+    from ar3cli.view.describe import contact_pairs
+
+    assert contact_pairs(found) == "none (not checked, their collision mesh does not load: b)"
 
 
 def _alive(pid: int | None) -> bool:
@@ -529,3 +533,26 @@ def test_a_sigterm_that_library_code_swallows_still_stops_the_viewer(tmp_path):
                           timeout=120, env={**os.environ, "PYTHONPATH": str(REPO)}, cwd=tmp_path)
     assert done.returncode == 143, done.stderr
     assert done.stderr.strip().endswith("ar3cli: terminated")
+
+
+def test_the_panel_shows_a_hostile_robot_s_names_as_text(tmp_path):
+    """The output boundary (issue 34) for the viewer: the panel texts of a robot whose names hold a
+    newline with a workflow command, ESC, C1, a bidi override, Markdown images and links and a
+    <script> render (as the browser's Markdown renders them) to plain text, every name shown."""
+    from ar3cli.analysis.findings import static_findings
+    from ar3cli.view.describe import findings_list, link_card
+    from tests.test_output_boundary import RAW, SHOWN, _rendered, robot
+
+    (tmp_path / "meshes").mkdir()
+    path = tmp_path / "hostile.urdf"
+    path.write_text(robot())
+    analysis = RobotAnalysis.load(path)
+    placed = place_findings(analysis, static_findings(analysis).findings)
+    pages = [findings_list(placed, analysis.shown_path)]
+    pages += [link_card(analysis, link.name, placed.by_link.get(link.name, []), [], analysis.shown_path)
+              for link in analysis.require_model().links]
+    for page in pages:
+        parsed = _rendered(page)
+        assert {tag for tag, _ in parsed.tags} <= {"p", "ul", "li", "strong", "br"}, (page, parsed.tags)
+        assert not any(character in page for character in RAW), page
+    assert all(part in "".join(_rendered(pages[0]).text) for part in SHOWN[:2])  # the names are there, as text

@@ -39,6 +39,8 @@ class Contacts:
     pairs: list[tuple[str, str]] = field(default_factory=list)
     note: str | None = None
     """Why nothing could be in contact (fewer than two links with collision geometry), else None."""
+    unchecked: list[str] = field(default_factory=list)
+    """Links left out of the check: pybullet cannot load their collision mesh (as sample-collisions)."""
 
     def links(self) -> set[str]:
         return {link for pair in self.pairs for link in pair}
@@ -47,15 +49,17 @@ class Contacts:
 def contacts(analysis: RobotAnalysis, values: Mapping[str, float]) -> Contacts:
     """The non-adjacent link pairs in contact at the configuration ``values`` (every 1-DOF joint's
     value by name, mimic joints included: :meth:`ar3cli.analysis.poses.Posing.joint_values`; a joint
-    left out is at 0). UserError when pybullet cannot load the robot or crashed."""
+    left out is at 0). UserError when pybullet cannot load the robot or crashed; a link whose
+    collision mesh it cannot load is left out (``unchecked``)."""
     from ar3cli.collisions.run import no_pairs_message
-    from ar3cli.sim.adjacency import collision_links
+    from ar3cli.sim.adjacency import collision_links, unloadable_collision_links
 
     model = analysis.require_model()
     if len(collision_links(model)) < 2:
         return Contacts(note=no_pairs_message(model).removeprefix(f"{model.path}: "))
     child: KeptChild = analysis.keep(CHECKER, lambda: open_checker(model))
-    return Contacts([tuple(pair) for pair in child.ask(dict(values))])  # type: ignore[misc]
+    return Contacts([tuple(pair) for pair in child.ask(dict(values))],  # type: ignore[misc]
+                    unchecked=unloadable_collision_links(model))
 
 
 def open_checker(model: Model) -> KeptChild:

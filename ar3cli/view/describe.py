@@ -73,11 +73,15 @@ def contact_pairs(contacts: Contacts) -> str:
     """``none``, or the pairs in contact (``a`` – ``b``), the first :data:`PAIRS_SHOWN` named."""
     if contacts.note is not None:
         return f"none possible ({literal(contacts.note)})"
+    unchecked = (f" (not checked, their collision mesh does not load: "
+                 f"{', '.join(literal(link) for link in contacts.unchecked[:PAIRS_SHOWN])}"
+                 f"{f' and {len(contacts.unchecked) - PAIRS_SHOWN} more' if len(contacts.unchecked) > PAIRS_SHOWN else ''})"
+                 if contacts.unchecked else "")
     if not contacts.pairs:
-        return "none"
+        return "none" + unchecked
     named = [f"{literal(a)} \u2013 {literal(b)}" for a, b in contacts.pairs[:PAIRS_SHOWN]]
     more = len(contacts.pairs) - PAIRS_SHOWN
-    return "; ".join(named) + (f"; and {more} more" if more > 0 else "")
+    return "; ".join(named) + (f"; and {more} more" if more > 0 else "") + unchecked
 
 
 def findings_list(placed: LinkFindings | None, shown_path: str) -> str:
