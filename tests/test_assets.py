@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import importlib.util
 import io
+import os
 import sys
 from collections.abc import Iterator
 from pathlib import Path
@@ -349,11 +350,19 @@ def test_examples_show_their_mistake_in_pybullet(pb: int) -> None:
     assert all(info[10] == 0.0 and info[11] == 0.0 for info in joint_table(pb, body).values() if info[2] != p.JOINT_FIXED)
 
 
+def _project_files() -> Iterator[Path]:
+    """Every file of the project's own, walking past git's store and any virtual environment
+    (the README's .venv and .venv-test, or one of another name, known by its pyvenv.cfg)."""
+    for folder, subfolders, files in os.walk(REPO):
+        subfolders[:] = [name for name in subfolders
+                         if name != ".git" and not (Path(folder) / name / "pyvenv.cfg").is_file()]
+        yield from (Path(folder) / name for name in files)
+
+
 def test_real_description_is_not_copied_into_the_repo() -> None:
     """Only numbers from the real AR3 may be used, never its files (checked anywhere in the repo)."""
     real_files = {path.read_bytes() for path in REAL.rglob("*") if path.is_file()} if REAL.is_dir() else set()
-    tracked = [path for path in REPO.rglob("*")
-               if path.is_file() and ".git" not in path.parts and ".venv" not in path.parts]
+    tracked = [path for path in _project_files() if path.is_file()]
     for path in tracked:
         assert not path.name.lower().endswith(".stl"), path
         if real_files and path.stat().st_size < 2_000_000:
