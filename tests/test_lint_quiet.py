@@ -122,3 +122,20 @@ def test_one_instability_is_one_finding(tmp_path, monkeypatch):
 def test_a_load_failure_a_static_error_explains_is_not_restated():
     findings = _lint("mujoco_meshdir/robot.urdf", select=("G001", "P001"), sim=True)
     assert set(_codes(findings)) == {"G001"}
+
+
+# The classes the quietness judge found next (docs/quietness.md, "New"), each at its cause.
+
+
+def test_a_limit_with_one_bound_says_what_each_tool_reads():
+    findings = {f.message.split("'")[1]: f for f in _lint("one_sided_limits.urdf") if f.rule == "J002"}
+    assert "finger_joint" not in findings  # upper only: every tool reads 0..0.04, the spec's default lower
+    assert "excludes 0" in findings["rail_joint"].message and "-9.65..-1" in findings["rail_joint"].message
+    assert "unlimited" in findings["flap_joint"].message and "-0.5..0" in findings["flap_joint"].message
+    assert "no lower or upper" in findings["wheel_joint"].message and "locked" in findings["wheel_joint"].message
+
+
+def test_a_mesh_as_large_as_the_robots_own_travel_is_metres():
+    assert "G006" not in _codes(_lint("gantry_hall.urdf"))  # a 46 m rail for a 37 m travel
+    (finding,) = [f for f in _lint("arm_with_mm_tool.urdf") if f.rule == "G006"]  # a 46 m tool on a 1 m arm
+    assert "millimetres?" in finding.message

@@ -176,6 +176,53 @@ class Context:
                     composite[i][j] += turned[i][j] + mass * ((square if i == j else 0.0) - d[i] * d[j])
         return total, symmetric_eigenvalues(composite)
 
+    def zero_pose_frame(self, name: str) -> tuple[Matrix, tuple[float, float, float]] | None:
+        """(rotation, origin) of link ``name``'s frame in its root link's frame with every joint at 0 (the
+        joint origins composed down the tree), or None for a link no root reaches or one below a joint
+        origin that is not finite. Computed for every link once per file."""
+        if "zero-pose-frames" not in self._shared:
+            self._shared["zero-pose-frames"] = self._zero_pose_frames()
+        return self._shared["zero-pose-frames"].get(name)
+
+    def _zero_pose_frames(self) -> dict[str, tuple[Matrix, tuple[float, float, float]]]:
+        model = self.model
+        frames: dict[str, tuple[Matrix, tuple[float, float, float]]] = {}
+        stack = [link.name for link in model.root_links()]
+        for name in stack:
+            frames[name] = (IDENTITY, (0.0, 0.0, 0.0))
+        while stack:
+            name = stack.pop()
+            rotation, origin = frames[name]
+            for joint in model.child_joints(name):
+                child = joint.child
+                if child is None or child in frames or model.link(child) is None:
+                    continue  # a link reached twice or a loop: S006's
+                values = (*joint.origin.xyz, *(v for row in joint.origin.rotation for v in row))
+                if not all(map(math.isfinite, values)):
+                    continue
+                frames[child] = (_matmul(rotation, joint.origin.rotation), _apply(rotation, joint.origin.xyz, origin))
+                stack.append(child)
+        return frames
+
+    def kinematic_span(self) -> float:
+        """Metres the robot's own joints span: the longest prismatic travel or the furthest link frame
+        from its root at the zero pose, whichever is more (0 for a robot of one link). What a size is
+        judged against besides the parts: a gantry whose rail travels 37 m is a building-sized robot, and
+        its 46 m rail is metres, not millimetres."""
+        if "kinematic-span" not in self._shared:
+            span = 0.0
+            for joint in self.model.joints:
+                limit = joint.limit
+                if joint.type == "prismatic" and limit is not None and limit.lower is not None \
+                        and limit.upper is not None and math.isfinite(limit.upper - limit.lower):
+                    span = max(span, limit.upper - limit.lower)
+            for link in self.model.links:
+                frame = self.zero_pose_frame(link.name)
+                if frame is not None:
+                    span = max(span, math.hypot(*frame[1]))
+            self._shared["kinematic-span"] = span
+        return self._shared["kinematic-span"]
+
     @property
     def session(self) -> Any:
         """A PyBullet session (gravity on) for ``--sim`` rules, opened on first use."""

@@ -17,6 +17,10 @@ MIN_PLAUSIBLE_EXTENT = 1e-3
 """A part smaller than a millimetre after scaling was probably scaled twice (or is in km)."""
 FLAT_RATIO = 0.01
 """Meshes whose smallest extent is below this fraction of the largest are planes (ground, walls)."""
+SPAN_FACTOR = 3.0
+"""A mesh larger than MAX_PLAUSIBLE_EXTENT is still metres when it is at most this many times the robot's own
+kinematic span (its longest prismatic travel, its furthest joint frame): a gantry lab's 46 m rail for a 37 m
+travel. A millimetre mesh on a metre robot is hundreds of times its span."""
 NON_SPEC_MESH_FORMATS = (".cdf", ".vtk")
 """Mesh extensions PyBullet's URDF importer accepts beyond .stl/.obj/.dae (G010, not G004)."""
 ZERO_THICKNESS = 1e-9
@@ -161,7 +165,8 @@ def lfs_pointer(ctx) -> Iterator[Hit]:
 @rule("G006", "mesh-units", "warning", "Mesh size suggests wrong units",
       why="""URDF meshes are in metres. A mesh exported in millimetres loads silently 1000x too large
       in PyBullet (a 30 cm link becomes 300 m); one scaled twice becomes sub-millimetre. Flat meshes
-      (ground planes, walls) are exempt. A COLLADA file states its own unit (<unit meter="0.0254"/>
+      (ground planes, walls) are exempt, and so is a large mesh on a robot whose own joints span as much
+      (a gantry lab whose rail travels 37 m: its 46 m rail is metres; in millimetres it would be 4.6 cm). A COLLADA file states its own unit (<unit meter="0.0254"/>
       for inches), which PyBullet and assimp (RViz, MoveIt) apply: the size is judged after it. Judged
       against the link itself too: a collision mesh about 1000 times larger or smaller than its own
       visual (a scale="0.001" kept on one and not the other) is in the other unit, whatever its size;
@@ -169,7 +174,9 @@ def lfs_pointer(ctx) -> Iterator[Hit]:
       fix='Add scale="0.001 0.001 0.001" for a millimetre mesh, or re-export it in metres.',
       bad=_mesh_robot("meshes/base_mm.stl"), good=_mesh_robot("meshes/base_mm.stl", "0.001 0.001 0.001"),
       thresholds="Largest extent after scale (and COLLADA unit) above MAX_PLAUSIBLE_EXTENT = 5 m with the smallest "
-                 "above FLAT_RATIO = 0.01 of it, or below MIN_PLAUSIBLE_EXTENT = 1 mm; or a link's collision meshes "
+                 "above FLAT_RATIO = 0.01 of it and the largest above SPAN_FACTOR = 3 times the robot's kinematic span "
+                 "(longest prismatic travel, furthest link frame from the root at the zero pose), or below "
+                 "MIN_PLAUSIBLE_EXTENT = 1 mm; or a link's collision meshes "
                  "SCALE_MISMATCH = 250 to 4000 times larger or smaller than its visual meshes (box diagonals).",
       references="PyBullet LoadMeshFromCollada.cpp (applies <unit meter>); COLLADA 1.4.1 spec, <asset>/<unit>.")
 def mesh_units(ctx) -> Iterator[Hit]:
@@ -206,7 +213,8 @@ def mesh_units(ctx) -> Iterator[Hit]:
         largest, smallest = max(extent), min(extent)
         shown = " x ".join(f"{e:.4g}" for e in extent) + " m after scaling" + (
             f" and the file's COLLADA unit ({unit:g} m)" if unit != 1.0 else "")
-        if largest > MAX_PLAUSIBLE_EXTENT and smallest > FLAT_RATIO * largest:
+        if largest > MAX_PLAUSIBLE_EXTENT and smallest > FLAT_RATIO * largest \
+                and largest > SPAN_FACTOR * ctx.kinematic_span():
             yield Hit(f"link '{link.name}' mesh {geometry.filename} is {shown}: millimetres?",
                       geometry.element)
         elif 0 < largest < MIN_PLAUSIBLE_EXTENT:
