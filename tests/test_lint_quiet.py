@@ -139,3 +139,13 @@ def test_a_mesh_as_large_as_the_robots_own_travel_is_metres():
     assert "G006" not in _codes(_lint("gantry_hall.urdf"))  # a 46 m rail for a 37 m travel
     (finding,) = [f for f in _lint("arm_with_mm_tool.urdf") if f.rule == "G006"]  # a 46 m tool on a 1 m arm
     assert "millimetres?" in finding.message
+
+
+def test_a_collision_kept_on_a_companion_link_covers_the_part():
+    findings = [f for f in _lint("companion_collision.urdf") if f.rule == "G015"]
+    assert [f.message.split("'")[1] for f in findings] == ["wrist"]  # 'elbow' is covered by 'elbow_collision'
+
+
+def test_parts_inside_their_neighbours_collision_and_drawn_frames_need_no_collision():
+    findings = [f for f in _lint("enclosed_parts.urdf") if f.rule == "G008"]
+    assert [f.message.split("'")[1] for f in findings] == ["handle"]

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from ar3cli.maths.tensor_math import symmetric_eigenvalues
-from ar3cli.urdf.bounds import Box, link_bounds, scaled_mesh_bounds, shape_bounds
+from ar3cli.urdf.bounds import Box, box_around, link_bounds, scaled_mesh_bounds, shape_bounds
 from ar3cli.urdf.model import Link, Model, Shape
 
 T = TypeVar("T")
@@ -203,6 +203,17 @@ class Context:
                 frames[child] = (_matmul(rotation, joint.origin.rotation), _apply(rotation, joint.origin.xyz, origin))
                 stack.append(child)
         return frames
+
+    def zero_pose_box(self, name: str, box: Box | None) -> Box | None:
+        """``box`` (in link ``name``'s frame) as an axis-aligned box in its root's frame at the zero pose
+        (:meth:`zero_pose_frame`), or None when either is unknown: where two links' shapes sit relative
+        to each other, without a simulator."""
+        frame = self.zero_pose_frame(name)
+        if box is None or frame is None:
+            return None
+        centre = [(lo + hi) / 2 for lo, hi in zip(*box)]
+        half = [(hi - lo) / 2 for lo, hi in zip(*box)]
+        return box_around(centre, half, frame[0], frame[1])
 
     def kinematic_span(self) -> float:
         """Metres the robot's own joints span: the longest prismatic travel or the furthest link frame

@@ -328,6 +328,16 @@ marker (a sensor frame drawn as a 1 cm cube, pr2's and Talos' IMU boxes), not a 
 MARKER_MASS = 1e-4
 """A link lighter than this fraction of the whole robot (or of mass 0) is a frame with a picture (Baxter's
 0.1 g display and camera links, a "nocol" marker sphere), not a body."""
+FRAME_DRAWING = 0.5
+"""A link with no <inertial>, welded to its parent and drawn with primitives (no mesh) smaller than this
+fraction of its parent is a frame drawn for people (Fourier's 5 mm fingertip spheres, a TCP ball), not a part."""
+ENCLOSED = 0.9
+"""A part whose drawing lies at least this much (by volume of its box) inside its neighbours' collision shapes at
+the zero pose needs no collision of its own: nothing reaches it without touching them first."""
+NEIGHBOUR_DEPTH = 2
+"""Joints away from a part that its neighbours may be (parent, grandparent, children, grandchildren, siblings)."""
+_GRID = 4
+"""Sample points per axis of a part's box when its enclosure is measured (4 x 4 x 4 cell centres)."""
 
 
 @rule("G008", "no-collision", "warning", "Link with visual but no collision geometry",
@@ -335,18 +345,26 @@ MARKER_MASS = 1e-4
       (no contacts, no self-collision checks), and PyBullet's default inertia comes from the
       collision shape, so it falls back to a tiny default box. Visuals meant to be passed through are
       not reported: a zero-size placeholder (<box size="0 0 0"/>), and markers, judged against the
-      robot itself: a link drawn much smaller than its other links, or one that weighs next to
-      nothing against the whole robot.""",
+      robot itself: a link drawn much smaller than its other links, one that weighs next to nothing
+      against the whole robot, or a frame drawn for people (no <inertial>, welded to its parent, drawn
+      as spheres, or as primitives much smaller than the parent: a fingertip or TCP marker). Nor is a part whose
+      drawing lies inside its neighbours' collision shapes at the zero pose (a wrist cross between
+      two covered links, a cover inside the chassis' collision mesh, a caster inside a base's
+      collision spheres): nothing reaches it without touching them first.""",
       fix="Add a <collision> (a primitive or a simplified mesh).",
       bad=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual></link>'),
       good=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual>'
                  '<collision><geometry><box size="1 1 1"/></geometry></collision></link>'),
       thresholds=f"Not reported: every visual of zero volume; visuals whose box diagonal is below MARKER_SIZE = "
                  f"{MARKER_SIZE:g} of the robot's median link size; a link whose mass is at most MARKER_MASS = "
-                 f"{MARKER_MASS:g} of the robot's.")
+                 f"{MARKER_MASS:g} of the robot's; a link without <inertial> on a fixed joint drawn with spheres, or with "
+                 f"primitives smaller than FRAME_DRAWING = {FRAME_DRAWING:g} of its parent; a link whose visual box lies at least "
+                 f"ENCLOSED = {ENCLOSED:g} inside the collision shapes of the links up to NEIGHBOUR_DEPTH = "
+                 f"{NEIGHBOUR_DEPTH} joints away at the zero pose.")
 def no_collision(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        if link.visuals and not link.collisions and not _pass_through_visual(ctx, link):
+        if link.visuals and not link.collisions and not _pass_through_visual(ctx, link) \
+                and not _enclosed(ctx, link):
             yield Hit(f"link '{link.name}' has {len(link.visuals)} visual shape(s) but no <collision>", link.element)
 
 
@@ -359,7 +377,62 @@ def _pass_through_visual(ctx, link) -> bool:
     if mass is not None and math.isfinite(mass) and 0 <= mass <= MARKER_MASS * ctx.total_mass():
         return True
     size, scale = ctx.link_size(link), ctx.robot_scale()
-    return size is not None and scale is not None and size < MARKER_SIZE * scale
+    if size is not None and scale is not None and size < MARKER_SIZE * scale:
+        return True
+    return _drawn_frame(ctx, link, size)
+
+
+def _drawn_frame(ctx, link, size: float | None) -> bool:
+    """A frame drawn for people: no <inertial> (the author gave it no body), welded to its parent, drawn with
+    spheres (a ball marks a point), or with primitives smaller than FRAME_DRAWING of its parent."""
+    joint = ctx.model.parent_joint(link.name)
+    if link.inertial is not None or joint is None or joint.type != "fixed" or size is None \
+            or any(shape.geometry.kind == "mesh" for shape in link.visuals):
+        return False
+    if all(shape.geometry.kind == "sphere" for shape in link.visuals):
+        return True  # a ball marks a point: a TCP, a fingertip
+    parent = ctx.model.link(joint.parent) if joint.parent else None
+    parent_size = ctx.link_size(parent) if parent is not None else None
+    return parent_size is not None and size < FRAME_DRAWING * parent_size
+
+
+def _neighbours(model, link, depth: int = NEIGHBOUR_DEPTH):
+    """The links up to ``depth`` joints from ``link`` (parent, children, and theirs), ``link`` left out."""
+    found, frontier = {link.name}, [link.name]
+    for _ in range(depth):
+        reached = []
+        for name in frontier:
+            joint = model.parent_joint(name)
+            around = [joint.parent] if joint is not None and joint.parent else []
+            around += [child.child for child in model.child_joints(name) if child.child]
+            reached += [other for other in around if other not in found]
+            found.update(around)
+        frontier = reached
+    found.discard(link.name)
+    return [other for name in found if (other := model.link(name)) is not None]
+
+
+def _enclosed(ctx, link) -> bool:
+    """True when at least ENCLOSED of the link's (visual) box lies inside the collision shapes of its
+    :func:`_neighbours` at the zero pose, sampled at _GRID³ cell centres."""
+    own = ctx.zero_pose_box(link.name, ctx.link_bounds(link))
+    if own is None:
+        return False
+    covers = [box for other in _neighbours(ctx.model, link) for shape in other.collisions
+              if (box := ctx.zero_pose_box(other.name, ctx.shape_bounds(shape))) is not None]
+    if not covers:
+        return False
+    steps = [(i + 0.5) / _GRID for i in range(_GRID)]
+    (x0, y0, z0), (x1, y1, z1) = own
+    inside = 0
+    for fx in steps:
+        x = x0 + fx * (x1 - x0)
+        for fy in steps:
+            y = y0 + fy * (y1 - y0)
+            for fz in steps:
+                z = z0 + fz * (z1 - z0)
+                inside += any(lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1] and lo[2] <= z <= hi[2] for lo, hi in covers)
+    return inside >= ENCLOSED * _GRID ** 3
 
 
 @rule("G009", "pybullet-only-path", "info", "Mesh found only by PyBullet's fallback search",
