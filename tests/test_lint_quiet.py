@@ -149,3 +149,8 @@ def test_a_collision_kept_on_a_companion_link_covers_the_part():
 def test_parts_inside_their_neighbours_collision_and_drawn_frames_need_no_collision():
     findings = [f for f in _lint("enclosed_parts.urdf") if f.rule == "G008"]
     assert [f.message.split("'")[1] for f in findings] == ["handle"]
+
+
+def test_an_inertia_is_judged_against_the_body_as_drawn_when_it_collides_as_a_placeholder():
+    findings = [f for f in _lint("placeholder_collision.urdf") if f.rule == "I007"]
+    assert [f.message.split("'")[1] for f in findings] == ["tag"]  # 'screen' is as large as drawn

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from ar3cli.maths.tensor_math import symmetric_eigenvalues
-from ar3cli.urdf.bounds import Box, box_around, link_bounds, scaled_mesh_bounds, shape_bounds
+from ar3cli.urdf.bounds import Box, box_around, box_union, link_bounds, scaled_mesh_bounds, shape_bounds
 from ar3cli.urdf.model import Link, Model, Shape
 
 T = TypeVar("T")
@@ -70,6 +70,17 @@ class Context:
         if link.name not in self._bounds:
             self._bounds[link.name] = link_bounds(link, self.shape_bounds)
         return self._bounds[link.name]
+
+    def body_bounds(self, link: Link) -> Box | None:
+        """Box around every visual and collision shape of the link, in its frame, or None: the body's extent
+        whichever of its shapes stands for it (Baxter's screen collides as a 1 mm placeholder sphere and is
+        drawn as its real 27 cm body). What a radius of gyration is judged against (I007)."""
+        key = "body:" + link.name
+        if key not in self._bounds:
+            boxes = [box for shape in (*link.visuals, *link.collisions) if (box := self.shape_bounds(shape)) is not None]
+            finite = boxes and all(all(map(math.isfinite, corner)) for box in boxes for corner in box)
+            self._bounds[key] = box_union(boxes) if finite else None
+        return self._bounds[key]
 
     def shape_bounds(self, shape: Shape) -> Box | None:
         """Box around one visual or collision shape in its link's frame, or None; computed once per

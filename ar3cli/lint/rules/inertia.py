@@ -335,7 +335,9 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
       its COM it cannot exceed the diagonal of its bounding box). A much larger value means the
       tensor belongs to something else: a placeholder I = 1 on a 0.1 kg link, grams vs kilograms, or
       g·mm² vs kg·m². The link then swings like a body many metres wide. A tensor no body can have
-      (I004, I005, I009) is reported there alone. When the tensor read in kg·mm² or g·mm² (a CAD
+      (I004, I005, I009) is reported there alone. The body's size is the box around all its shapes,
+      visual and collision: a part that collides as a placeholder (Baxter's screen, a 1 mm sphere) is
+      still as large as it is drawn. When the tensor read in kg·mm² or g·mm² (a CAD
       export's units) gives the robot's typical radius of gyration, the message says so, with the
       value in kg·m².""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
@@ -343,8 +345,8 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
                          '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'),
       good=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision>'),
       fixed_by="fix-inertia --include-implausible",
-      thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the link's "
-                 "geometry box (collision shapes, else visual). A unit is named when the tensor / 1e6 (kg·mm²) or / 1e9 "
+      thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the box around the "
+                 "link's visual and collision shapes. A unit is named when the tensor / 1e6 (kg·mm²) or / 1e9 "
                  "(g·mm²) gives a ratio within SAME_SHAPE = 5x of the robot's median link ratio and an I_max within "
                  "SOLID_RANGE = 0.05 to 4 times a solid box the size of the geometry; never for a placeholder (a "
                  "diagonal of powers of ten).")
@@ -380,7 +382,7 @@ def _gyration(ctx, link, mass: float | None) -> tuple[float, float, float, float
     if inertial is None or not finite_tensor(inertial.tensor) or mass is None or not mass > 0 \
             or not math.isfinite(mass):
         return None
-    bounds = ctx.link_bounds(link)
+    bounds = ctx.body_bounds(link)
     if bounds is None:
         return None
     half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
@@ -433,7 +435,7 @@ def tensor_unit(ctx, link) -> tuple[str, float] | None:
     if found is None or found[0] <= IMPLAUSIBLE_FACTOR or _placeholder_tensor(link.inertial.tensor):
         return None
     mass = mass or link.inertial.mass
-    box = ctx.link_bounds(link)
+    box = ctx.body_bounds(link)
     extents = sorted(hi - lo for lo, hi in zip(*box))
     solid = mass * (extents[1] ** 2 + extents[2] ** 2) / 12  # I_max of a solid box the size of the geometry
     typical = typical_gyration(ctx)
