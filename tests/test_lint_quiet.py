@@ -154,3 +154,27 @@ def test_parts_inside_their_neighbours_collision_and_drawn_frames_need_no_collis
 def test_an_inertia_is_judged_against_the_body_as_drawn_when_it_collides_as_a_placeholder():
     findings = [f for f in _lint("placeholder_collision.urdf") if f.rule == "I007"]
     assert [f.message.split("'")[1] for f in findings] == ["tag"]  # 'screen' is as large as drawn
+
+
+def _by_file(folder: str, sim: bool = False) -> dict[str, list]:
+    options = LintOptions(select=["ALL"], sim=sim)
+    from ar3cli.lint.engine import lint_paths
+
+    return {Path(r.path).name: r.findings for r in lint_paths([DATA / folder], options, use_cache=False, jobs=1)}
+
+
+def test_libraries_and_include_bodies_are_one_info_line_and_entry_failures_stay_errors():
+    found = _by_file("fragments")
+    assert _codes(found["body.xacro"]) == ["F008"] and "$(arg mesh_dir) without declaring it" in found["body.xacro"][0].message
+    assert _codes(found["legacy_macros.xacro"]) == ["F008"]  # <property> without the xacro: prefix
+    (library,) = found["needs_workspace.xacro"]
+    assert library.rule == "F008" and library.severity is Severity.INFO and "absent_resources" in library.message
+    assert _codes(found["entry_without_arg.xacro"]) == ["F004"]  # it declares its argument: its own failure
+    assert _codes(found["entry_missing_include.xacro"]) == ["F004"]  # xacro's include failure, not F001
+    assert found["robot.urdf.xacro"] == []
+
+
+@pytest.mark.slow
+def test_a_macro_library_is_one_info_line_with_the_pybullet_rules_too():
+    found = _by_file("fragments", sim=True)
+    assert _codes(found["legacy_macros.xacro"]) == ["F008"] and _codes(found["needs_workspace.xacro"]) == ["F008"]

@@ -229,7 +229,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
     try:
         model = load_model(path, options.package_paths, options.xacro_args)
     except UserError as exc:
-        return unloaded_result(load_failure(path, shown, exc.message), options)
+        return unloaded_result(included_failure(path, load_failure(path, shown, exc.message)), options)
     except RecursionError:
         return unloaded_result(Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown), options)
     result = lint_model(model, shown, rules, options)
@@ -324,6 +324,23 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions) -> li
     return findings
 
 
+def included_failure(path: Path, failure: Finding) -> Finding:
+    """``failure``, or F008 at info when it is an F004 of a xacro library or of a fragment a file of its
+    package includes (:func:`~ar3cli.lint.rules.file.fragment_message`): the includer reports it."""
+    from ar3cli.infra.safe_read import read_bytes
+    from ar3cli.lint.rules.file import fragment_message
+
+    if failure.rule != "F004":
+        return failure
+    try:
+        message = fragment_message(path, read_bytes(path), failure.message)
+    except UserError:
+        return failure
+    if message is None:
+        return failure
+    return Finding(LIBRARY, REGISTRY[LIBRARY].severity, message, failure.path, 0, 0, REGISTRY[LIBRARY].fix)
+
+
 def load_failure(path: Path, shown: str, message: str) -> Finding:
     """Turn the loader's one-line UserError into an F001-F004 finding on the file."""
     line = 0
@@ -333,11 +350,11 @@ def load_failure(path: Path, shown: str, message: str) -> Finding:
             line = int(match.group(1) or 0)
             message = message[match.end():]
             break
-    if any(key in message for key in ("no such file", "is a directory", "not a regular file", "cannot read",
-                                      "MB limit")):
+    if "xacro error" in message or "$(find" in message:
+        code = "F004"  # an include xacro cannot read is the expansion's failure, not the file's
+    elif any(key in message for key in ("no such file", "is a directory", "not a regular file", "cannot read",
+                                        "MB limit")):
         code = "F001"
-    elif "xacro error" in message or "$(find" in message:
-        code = "F004"
     elif message.startswith("root element is"):
         code = "F003"
     else:
