@@ -178,3 +178,24 @@ def test_libraries_and_include_bodies_are_one_info_line_and_entry_failures_stay_
 def test_a_macro_library_is_one_info_line_with_the_pybullet_rules_too():
     found = _by_file("fragments", sim=True)
     assert _codes(found["legacy_macros.xacro"]) == ["F008"] and _codes(found["needs_workspace.xacro"]) == ["F008"]
+
+
+def test_a_frame_welded_to_the_root_is_the_bases_one_info_and_a_tool_frame_stays_a_warning():
+    findings = [f for f in _lint("mounting_plate.urdf") if f.rule in ("I002", "I012")]
+    assert [(f.rule, f.severity) for f in findings] == [("I012", Severity.INFO), ("I002", Severity.WARNING)]
+    assert "'plate_top_centre'" in findings[0].message and "if this robot floats" in findings[0].message
+    assert "'tool0'" in findings[1].message
+
+
+def test_a_planar_bases_virtual_links_are_an_info_for_pybullet_and_an_error_for_mujoco():
+    default = [(f.rule, f.message.split("'")[1]) for f in _lint("planar_base.urdf") if f.rule in ("I001", "I017")]
+    assert sorted(default) == [("I001", "slider"), ("I017", "virtual1"), ("I017", "virtual2")]
+    mujoco = [f for f in _lint("planar_base.urdf", targets=("mujoco",)) if f.rule in ("I001", "I017")]
+    assert sorted(f.message.split("'")[1] for f in mujoco) == ["slider", "virtual1", "virtual2"]
+    assert {f.rule for f in mujoco} == {"I001"}
+    assert "I015" not in _codes(_lint("planar_base.urdf"))  # a light link between two joints is carried
+
+
+def test_a_light_link_between_two_joints_is_carried_and_a_light_tip_is_not():
+    findings = [f for f in _lint("biped_sliders.urdf") if f.rule == "I015"]
+    assert [f.message.split("'")[1] for f in findings] == ["feeler_joint"]

@@ -84,30 +84,103 @@ def _fmt(moments) -> str:
                  "'world'); docs/pybullet-facts.md.")
 def inertial_missing(ctx) -> Iterator[Hit]:
     moving = _moving_links(ctx.model)
+    phantom_only = not set(ctx.targets) & REFUSE_MASSLESS
     for link in ctx.model.links:
         if link.inertial is None and link.name in moving:
+            if phantom_only and translating_frame(ctx, link) is not None:
+                continue  # PyBullet's 1 kg on a frame that only translates, carrying far more: I017's, an info
             yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') but has no <inertial>: "
                       "PyBullet uses 1 kg and I = 1", link.element)
+
+
+PHANTOM_SHARE = 0.02
+"""PyBullet's 1 kg on a frame that only translates is at most this share of the mass it carries (I017)."""
+REFUSE_MASSLESS = frozenset({"mujoco", "drake", "gazebo"})
+"""Targets for which a moving link without <inertial> is an error whatever it carries: MuJoCo refuses a moving
+body without mass (below mjMINVAL), Drake's is singular, Gazebo drops the link."""
+
+
+def translating_frame(ctx, link) -> float | None:
+    """The mass (kg, from the file) that ``link``'s prismatic joint moves, when ``link`` is a frame of a virtual
+    planar base: no <inertial> and no geometry, every joint from a geometry-less root down to it prismatic (or
+    fixed), so it never rotates and its I = 1 plays no part; and PyBullet's 1 kg is at most PHANTOM_SHARE of what
+    it carries. None otherwise."""
+    from ar3cli.lint.rules.plausibility import subtree_masses
+
+    if link.inertial is not None or link.has_geometry:
+        return None
+    above = list(ctx.model.joints_above(link.name))
+    if not above or above[0].type != "prismatic" or any(j.type not in ("prismatic", "fixed") for j in above):
+        return None
+    root = ctx.model.link(above[-1].parent) if above[-1].parent else None
+    if root is None or root.has_geometry or ctx.model.parent_joint(root.name) is not None:
+        return None
+    carried = ctx.shared("subtree-masses", subtree_masses)[link.name]
+    return carried if carried > 0 and 1.0 <= PHANTOM_SHARE * carried else None
+
+
+@rule("I017", "translating-frame-inertial-missing", "info", "A planar base's virtual link without <inertial>",
+      engines=("pybullet",),
+      why="""A mobile base moved in the plane is often written as a chain of virtual links: x and y prismatic
+      joints from a fixed root, then the yaw joint to the chassis (Clearpath's Ridgeback). Its x/y links have
+      no <inertial>: PyBullet gives each 1 kg and I = 1, but they never rotate, so the inertia plays no part,
+      and a kilogram on a base of a hundred moves it barely differently (measured with pybullet 3.2.7 on a
+      165 kg base with two such links: 1.2% less travel under the same force, yaw unchanged). I001 reports
+      such a link when the 1 kg is a larger share of what it carries, or when --target names MuJoCo, Drake
+      or Gazebo (MuJoCo refuses a moving body without mass).""",
+      fix="Give the virtual links a tiny <inertial> (mass 1e-6 kg, I = 1e-12), or leave them.",
+      bad=robot(f"""
+          <link name="odom"/><link name="x_link"/>
+          <link name="chassis"><inertial><mass value="165"/><inertia ixx="4" ixy="0" ixz="0" iyy="8" iyz="0" izz="10"/></inertial></link>
+          <joint name="x" type="prismatic"><parent link="odom"/><child link="x_link"/><axis xyz="1 0 0"/>
+            <limit lower="-100" upper="100" effort="100" velocity="1"/></joint>
+          <joint name="yaw" type="continuous"><parent link="x_link"/><child link="chassis"/><axis xyz="0 0 1"/></joint>"""),
+      good=robot(f"""
+          <link name="odom"/>
+          <link name="x_link"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
+          <link name="chassis"><inertial><mass value="165"/><inertia ixx="4" ixy="0" ixz="0" iyy="8" iyz="0" izz="10"/></inertial></link>
+          <joint name="x" type="prismatic"><parent link="odom"/><child link="x_link"/><axis xyz="1 0 0"/>
+            <limit lower="-100" upper="100" effort="100" velocity="1"/></joint>
+          <joint name="yaw" type="continuous"><parent link="x_link"/><child link="chassis"/><axis xyz="0 0 1"/></joint>"""),
+      thresholds="A link without <inertial> and geometry whose parent joint is prismatic, every joint above it "
+                 "prismatic or fixed from a root without geometry, carrying at least 1 kg / PHANTOM_SHARE = 50 kg; "
+                 "only when --target names none of MuJoCo, Drake, Gazebo (else I001).")
+def translating_frame_inertial_missing(ctx) -> Iterator[Hit]:
+    if set(ctx.targets) & REFUSE_MASSLESS:
+        return
+    for link in ctx.model.links:
+        carried = translating_frame(ctx, link)
+        if carried is not None:
+            joint = ctx.model.parent_joint(link.name)
+            yield Hit(f"link '{link.name}' (prismatic joint '{joint.name}') has no <inertial>: PyBullet gives it 1 kg, "
+                      f"{100 / carried:.1g}% of the {carried:g} kg it carries, and I = 1, which plays no part: it never "
+                      "rotates", link.element)
 
 
 @rule("I002", "fixed-link-inertial-missing", "warning", "Link on a fixed joint without <inertial>",
       engines=("pybullet",),
       why="""A frame link (tool tip, sensor frame) hangs from a fixed joint and often has neither
       geometry nor <inertial>. PyBullet still gives it 1 kg and I = 1, so every tcp/camera frame adds
-      a kilogram to the arm's end.""",
+      a kilogram to the arm's end. A link welded to the root (the base's frames, a mounting plate's
+      markers) belongs to the base: its kilogram matters only if the robot floats, which I012 says, once
+      for the base, at info.""",
       fix="Add a tiny <inertial> (mass 1e-6 kg, I = 1e-12: measured to act like mass 0 within 3e-6 N·m) or run ar3cli fix-inertia.",
       bad=robot(f"""
-          <link name="base">{LINK_INERTIAL}</link><link name="tcp"/>
-          <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""),
+          <link name="base">{LINK_INERTIAL}</link><link name="arm">{LINK_INERTIAL}</link><link name="tcp"/>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <joint name="tcp_joint" type="fixed"><parent link="arm"/><child link="tcp"/></joint>"""),
       good=robot(f"""
-          <link name="base">{LINK_INERTIAL}</link>
+          <link name="base">{LINK_INERTIAL}</link><link name="arm">{LINK_INERTIAL}</link>
           <link name="tcp"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
-          <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""),
+          <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <joint name="tcp_joint" type="fixed"><parent link="arm"/><child link="tcp"/></joint>"""),
       fixed_by="fix-inertia")
 def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         link = ctx.model.link(joint.child) if joint.type == "fixed" and joint.child else None
-        if link is None or link.inertial is not None or link.name == "world":
+        if link is None or link.inertial is not None or link.name == "world" or _welded_to_root(ctx, link):
             continue
         kind = "has geometry" if link.has_geometry else FRAME_LINK_PHRASE
         yield Hit(f"link '{link.name}' {kind} on fixed joint '{joint.name}' without <inertial>: "
@@ -501,6 +574,12 @@ def world_inertial(ctx) -> Iterator[Hit]:
                       link.inertial.element)
 
 
+def _welded_to_root(ctx, link) -> bool:
+    """Whether ``link`` is welded (fixed joints only) to a root link: part of the base, static when the robot is
+    loaded with a fixed base, so its phantom kilogram matters only if the robot floats (I012's, at info)."""
+    return ctx.model.parent_joint(ctx.rigid_body(link).top) is None
+
+
 def _looks_like_frame(link) -> bool:
     return not link.has_geometry or link.name.lower() in DUMMY_ROOT_NAMES
 
@@ -513,13 +592,17 @@ def _looks_like_frame(link) -> bool:
       apart from a C-level warning; Drake makes it a massless free body, whose dynamics are
       singular. (MuJoCo's URDF import fixes the root to the world whatever its mass.)
       Roots without geometry (world, base_footprint: frames by ROS convention, where KDL wants no
-      inertia) are not reported.""",
+      inertia) are not reported. Links welded to the root by fixed joints belong to the same body: those
+      without <inertial> add PyBullet's 1 kg each to it when it floats, and nothing when it is fixed, so
+      they are listed here (one finding for the base) rather than as I002 warnings.""",
       fix="If the robot floats, give the root link its real <inertial> (ar3cli fix-inertia --links ROOT computes one "
-          "from the geometry); if it is always fixed to the world, nothing to do.",
+          "from the geometry) and the frames welded to it a tiny one; if it is always fixed to the world, nothing to "
+          "do.",
       bad=robot('''<link name="chassis"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
       good=robot(f'''<link name="chassis">{LINK_INERTIAL}<collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
       thresholds="Frame roots are skipped: no visual or collision geometry, or a name in DUMMY_ROOT_NAMES "
-                 "(world, map, odom, base_footprint, dummy, root, base_root).",
+                 "(world, map, odom, base_footprint, dummy, root, base_root); a root named 'world' (mass 0 in PyBullet: "
+                 "static) is not reported with its welded links either.",
       references="PyBullet UrdfParser.cpp parseLink (mass 1, inertia 1 without <inertial>); Drake "
                  "multibody/parsing/detail_urdf_parser.cc ParseBody (no <inertial>: zero spatial inertia).")
 def root_inertial_missing(ctx) -> Iterator[Hit]:
@@ -527,11 +610,24 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
     if len(roots) != 1:
         return  # no root or several: S005's business
     root = roots[0]
+    if root.name == "world":
+        return  # PyBullet's only mass-0 default: a static base, with whatever is welded to it
+    welded = [name for name in ctx.rigid_body(root).members if name not in (root.name, "world")
+              and ctx.model.link(name).inertial is None]
+    shown = ", ".join(f"'{name}'" for name in welded[:3]) + (", ..." if len(welded) > 3 else "")
     if root.inertial is None and not _looks_like_frame(root):
-        yield Hit(f"root link '{root.name}' has geometry but no <inertial>: if this robot floats, PyBullet gives it "
-                  "1 kg and I = 1, Drake no mass at all", root.element,
+        also = (f", nor {'do' if len(welded) > 1 else 'does'} the {len(welded)} link{'s' if len(welded) > 1 else ''} "
+                f"welded to it ({shown})" if welded else "")
+        yield Hit(f"root link '{root.name}' has geometry but no <inertial>{also}: if this robot floats, PyBullet gives "
+                  f"{'each' if welded else 'it'} 1 kg and I = 1, Drake no mass at all", root.element,
                   hint=f"If the robot floats: ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write "
                        "the real <inertial>); a fixed-base arm can ignore this.")
+    elif welded:
+        yield Hit(f"{len(welded)} link{'s' if len(welded) > 1 else ''} welded to root link '{root.name}' "
+                  f"{'have' if len(welded) > 1 else 'has'} no <inertial> ({shown}): if this robot floats, PyBullet adds "
+                  "1 kg and I = 1 for each to its base", ctx.model.link(welded[0]).element,
+                  hint="If the robot floats: give each a tiny <inertial> (mass 1e-6 kg, I = 1e-12) or run ar3cli "
+                       "fix-inertia; a fixed-base robot can ignore this.")
 
 
 FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,
@@ -541,7 +637,8 @@ in its order of reasons: I007 last, so a link reported as I007 has nothing inval
 RESCALED_BY_FIX_INERTIA = (density_implausible,)
 """Rules fix-inertia answers by rescaling the file's own numbers where their unit is plain (a mass in grams,
 I013; I007's tensors in kg·mm² or g·mm² too): :func:`unit_mistakes`."""
-NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
+NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing,
+                            translating_frame_inertial_missing)
 """Inertia findings fix-inertia leaves alone: the fix is a decision only the author can make."""
 
 
