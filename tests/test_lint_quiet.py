@@ -199,3 +199,26 @@ def test_a_planar_bases_virtual_links_are_an_info_for_pybullet_and_an_error_for_
 def test_a_light_link_between_two_joints_is_carried_and_a_light_tip_is_not():
     findings = [f for f in _lint("biped_sliders.urdf") if f.rule == "I015"]
     assert [f.message.split("'")[1] for f in findings] == ["feeler_joint"]
+
+
+def test_an_identity_origin_where_none_is_read_loses_nothing():
+    findings = [f for f in _lint("ignored_origin.urdf") if f.rule == "S016"]
+    assert [f.line for f in findings] == [_line("ignored_origin.urdf", '<origin xyz="0 0 0.05"/>')]
+
+
+def test_a_quirk_of_a_xacro_expansion_points_into_the_source_or_nowhere():
+    from ar3cli.urdf.xmlsource import Quirk, source_lines
+
+    expanded = [Quirk("undeclared-prefix", "namespace prefix drake is used but never declared", 393),
+                Quirk("trailing-junk", "content after the root element", 400)]
+    source = b'<?xml version="1.0"?>\n<robot name="r">\n  <drake:filter/>\n</robot>\n'
+    assert [q.line for q in source_lines(expanded, source)] == [3, 0]
+    assert [q.line for q in source_lines(expanded[:1], b'<robot name="r"/>')] == [0]  # only an include uses it
+
+
+def test_a_missing_mesh_names_the_first_place_looked_and_the_hint_all_of_them():
+    (finding,) = [f for f in _lint("missing_package_mesh.urdf") if f.rule == "G001"]
+    first, _, rest = finding.message.partition("; looked in ")
+    assert "package 'absent_support' not found" in first and " more places" in rest
+    assert finding.hint.startswith("Fix the path") and finding.hint.count(";") >= 2
+    assert len(finding.message) < len(finding.hint)

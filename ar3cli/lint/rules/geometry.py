@@ -57,6 +57,9 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
         </link>""")
 
 
+G001_FIX = "Fix the path, or tell ar3cli where the package is with --package-path NAME=DIR."
+
+
 @rule("G001", "mesh-not-found", "error", "Mesh file not found",
       refused_by=("pybullet", "mujoco"),
       breaks='PyBullet refuses the file ("Cannot load URDF file"); RViz and MoveIt draw and collide nothing for '
@@ -64,10 +67,10 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
       why="""PyBullet refuses the whole file with "Cannot load URDF file" (the real reason, the missing
       mesh, only goes to C stdout); RViz shows nothing. ar3cli resolves package:// like ROS
       (--package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, package.xml in ancestors) and relative
-      paths like PyBullet, and lists every place it looked. MuJoCo looks elsewhere: in the
+      paths like PyBullet; the message names the first place it looked and the hint every one. MuJoCo looks elsewhere: in the
       <mujoco><compiler meshdir> of the file, by the mesh's base name; for a robot meant for MuJoCo
       only (--target mujoco) a mesh found there is not reported.""",
-      fix="Fix the path, or tell ar3cli where the package is with --package-path NAME=DIR.",
+      fix=G001_FIX,
       bad=_mesh_robot("meshes/missing.stl"), good=_mesh_robot("meshes/base.stl"),
       references="MuJoCo src/xml/xml_urdf.cc (mesh file names stripped to their base name, looked up in "
                  "<mujoco><compiler meshdir>).")
@@ -76,7 +79,12 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
-            tried = "; looked in " + ", ".join(resolution.tried) if resolution.tried else ""
+            tried, hint = "", None
+            if resolution.tried:  # the message names the first place, the hint every one (11 paths on one line)
+                more = len(resolution.tried) - 1
+                tried = f"; looked in {resolution.tried[0]}" + (f" and {more} more place{'s' if more > 1 else ''}"
+                                                                 if more else "")
+                hint = f"{G001_FIX} Looked in: " + "; ".join(resolution.tried) + "."
             also = ""
             if meshdir is not None and ctx.model.resolver.is_file(meshdir / _base_name(resolution.uri)):
                 others = [target for target in ctx.targets if target != "mujoco"]
@@ -84,7 +92,7 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
                     continue  # MuJoCo, the only target, finds it through its own meshdir
                 also = f" (only MuJoCo finds it, in its <compiler meshdir> {meshdir})"
             yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{also}{tried}",
-                      geometry.element)
+                      geometry.element, hint=hint)
 
 
 def mujoco_meshdir(model) -> Path | None:
