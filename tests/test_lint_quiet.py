@@ -222,3 +222,15 @@ def test_a_missing_mesh_names_the_first_place_looked_and_the_hint_all_of_them():
     assert "package 'absent_support' not found" in first and " more places" in rest
     assert finding.hint.startswith("Fix the path") and finding.hint.count(";") >= 2
     assert len(finding.message) < len(finding.hint)
+
+
+@pytest.mark.parametrize("jobs", [1, 2])
+def test_a_macros_finding_is_reported_once_for_every_robot_that_includes_it(jobs):
+    from ar3cli.lint.engine import lint_paths
+
+    options = LintOptions(select=["ALL"])
+    results = lint_paths([DATA / "shared_macro"], options, use_cache=False, jobs=jobs)
+    found = [f for r in results for f in r.findings if f.rule == "G008"]
+    (finding,) = found
+    assert finding.path.endswith("parts.xacro") and "found through 3 linted files" in finding.message
+    assert "robot_b.urdf.xacro" in finding.hint and "robot_c.urdf.xacro" in finding.hint

@@ -138,6 +138,7 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     :func:`~ar3cli.infra.process_pool.worker_count`); the results do not depend on it.
     """
     from ar3cli.infra.process_pool import map_in_processes
+    from ar3cli.lint.included import merge_included
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
@@ -145,7 +146,7 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
     if workers <= 1:
-        return [lint_file(path, rules, options, cache) for path in files]
+        return merge_included([lint_file(path, rules, options, cache) for path in files])
     take_learned()  # what this process knows already need not come back from every child
     job = functools.partial(_lint_file_in_worker, rules=rules, options=options, cache=cache)
     order = balanced_order(sizes, workers)
@@ -154,7 +155,7 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     for index, (result, learned) in zip(order, outcomes):
         merge_learned(learned)
         results[index] = result
-    return results
+    return merge_included(results)
 
 
 def _workers(jobs: int | None, sizes: list[int], sim: bool) -> int:
