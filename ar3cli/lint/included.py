@@ -9,17 +9,14 @@ them. Findings in the linted file itself are never merged: two robots may well s
 from __future__ import annotations
 
 import dataclasses
-from typing import TYPE_CHECKING
-
-if TYPE_CHECKING:
-    from ar3cli.lint.engine import LintResult
+from typing import Any
 
 NAMED = 3
 """Other linted files the hint names (the rest are counted)."""
 
 
-def merge_included(results: list[LintResult]) -> list[LintResult]:
-    """``results`` with each finding that points into an included file (its path is not the linted file's)
+def merge_included(results: list[Any]) -> list[Any]:
+    """``results`` (:class:`~ar3cli.lint.engine.LintResult`, in order) with each finding that points into an included file (its path is not the linted file's)
     kept in the first result that has it and dropped from the others, its message saying how many linted
     files include it. Results without such repeats come back as they are."""
     first: dict[tuple, tuple[int, int]] = {}  # finding identity -> (result index, finding index)

@@ -116,7 +116,7 @@ def translating_frame(ctx, link) -> float | None:
     if root is None or root.has_geometry or ctx.model.parent_joint(root.name) is not None:
         return None
     carried = ctx.shared("subtree-masses", subtree_masses)[link.name]
-    return carried if carried > 0 and 1.0 <= PHANTOM_SHARE * carried else None
+    return carried if carried > 0 and PHANTOM_SHARE * carried >= 1.0 else None
 
 
 @rule("I017", "translating-frame-inertial-missing", "info", "A planar base's virtual link without <inertial>",
@@ -129,13 +129,13 @@ def translating_frame(ctx, link) -> float | None:
       such a link when the 1 kg is a larger share of what it carries, or when --target names MuJoCo, Drake
       or Gazebo (MuJoCo refuses a moving body without mass).""",
       fix="Give the virtual links a tiny <inertial> (mass 1e-6 kg, I = 1e-12), or leave them.",
-      bad=robot(f"""
+      bad=robot("""
           <link name="odom"/><link name="x_link"/>
           <link name="chassis"><inertial><mass value="165"/><inertia ixx="4" ixy="0" ixz="0" iyy="8" iyz="0" izz="10"/></inertial></link>
           <joint name="x" type="prismatic"><parent link="odom"/><child link="x_link"/><axis xyz="1 0 0"/>
             <limit lower="-100" upper="100" effort="100" velocity="1"/></joint>
           <joint name="yaw" type="continuous"><parent link="x_link"/><child link="chassis"/><axis xyz="0 0 1"/></joint>"""),
-      good=robot(f"""
+      good=robot("""
           <link name="odom"/>
           <link name="x_link"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
           <link name="chassis"><inertial><mass value="165"/><inertia ixx="4" ixy="0" ixz="0" iyy="8" iyz="0" izz="10"/></inertial></link>
