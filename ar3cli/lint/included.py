@@ -16,9 +16,10 @@ NAMED = 3
 
 
 def merge_included(results: list[Any]) -> list[Any]:
-    """``results`` (:class:`~ar3cli.lint.engine.LintResult`, in order) with each finding that points into an included file (its path is not the linted file's)
-    kept in the first result that has it and dropped from the others, its message saying how many linted
-    files include it. Results without such repeats come back as they are."""
+    """``results`` (:class:`~ar3cli.lint.engine.LintResult`, in order) with each finding that points into
+    an included file (its path is not the linted file's) kept in the first result that has it and dropped
+    from the others, its message saying how many linted files include it. Results without such repeats come
+    back as they are."""
     first: dict[tuple, tuple[int, int]] = {}  # finding identity -> (result index, finding index)
     also: dict[tuple, list[str]] = {}
     kept: list[list] = []
