@@ -234,3 +234,18 @@ def test_a_macros_finding_is_reported_once_for_every_robot_that_includes_it(jobs
     (finding,) = found
     assert finding.path.endswith("parts.xacro") and "found through 3 linted files" in finding.message
     assert "robot_b.urdf.xacro" in finding.hint and "robot_c.urdf.xacro" in finding.hint
+
+
+def test_a_zero_size_collision_is_found_at_the_shape_and_is_an_error_for_mujoco():
+    (info,) = [f for f in _lint("zero_size_collision.urdf") if f.rule == "G018"]
+    assert info.severity is Severity.INFO  # PyBullet and ROS load it
+    assert info.line == _line("zero_size_collision.urdf", '<sphere radius="0.00"/>')
+    (error,) = [f for f in _lint("zero_size_collision.urdf", targets=("mujoco",)) if f.rule == "G018"]
+    assert error.severity is Severity.ERROR and "MuJoCo refuses" in error.message
+
+
+@pytest.mark.slow
+def test_mujocos_refusal_of_a_zero_size_collision_is_not_restated():
+    pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
+    findings = _lint("zero_size_collision.urdf", select=("G018", "M001"), sim=True, engines=("mujoco",))
+    assert _codes(findings) == ["G018"]

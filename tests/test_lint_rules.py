@@ -49,7 +49,10 @@ def write_fixture(folder: Path, text: str, files: dict[str, bytes] | None = None
 
 def codes_for(path: Path, code: str) -> list:
     rule = REGISTRY[code]
-    options = LintOptions(sim=rule.needs_sim, select=["ALL", code])  # naming the code runs an opt-in rule
+    targets = LintOptions().targets
+    if rule.target_bound and not set(rule.engines) & set(targets):
+        targets = rule.engines  # a rule about MuJoCo only (G018) is linted for MuJoCo, where it has its severity
+    options = LintOptions(sim=rule.needs_sim, select=["ALL", code], targets=targets)  # naming the code runs an opt-in rule
     return [f for f in lint_file(path, options.rules(), options).findings if f.rule == code]
 
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.lint.rules.file import SUBSTITUTION
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
+from ar3cli.urdf.model import parse_floats
 
 MAX_PLAUSIBLE_EXTENT = 5.0
 """A robot part larger than this many metres after scaling is almost always a mesh in millimetres."""
@@ -618,6 +619,38 @@ def mesh_flat(ctx) -> Iterator[Hit]:
         if flat:
             yield Hit(f"link '{link.name}' collision mesh {shape.geometry.filename} is flat (no volume): MuJoCo 3.3+ "
                       "refuses it as a collision shape", shape.geometry.element)
+
+
+ZERO_SIZE_KEYS = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "length"),
+                  "capsule": ("radius", "length")}
+"""The size attributes of each primitive (G018)."""
+
+
+@rule("G018", "zero-size-collision", "error", "Collision primitive of zero size",
+      engines=("mujoco",), refused_by=("mujoco",),
+      breaks='MuJoCo refuses the file ("size 0 must be positive in geom"; measured with MuJoCo 4.0).',
+      why="""A <collision> box, sphere, cylinder or capsule with a size of 0 (<sphere radius="0.00"/>, a
+      placeholder left by an exporter) collides as nothing in PyBullet, which loads it, and stops
+      MuJoCo's whole compile ("size 0 must be positive in geom", measured with MuJoCo 4.0 on ARMAR-4's
+      legs and eyes). A zero-size <visual> is a placeholder every engine draws as nothing (G008 leaves it
+      alone). Negative sizes are the same mistake.""",
+      fix="Give the collision shape its real size, or remove the <collision>.",
+      bad=robot(f'<link name="base">{LINK_INERTIAL}<collision><geometry><sphere radius="0.00"/></geometry></collision></link>'),
+      good=robot(f'<link name="base">{LINK_INERTIAL}<collision><geometry><sphere radius="0.02"/></geometry></collision></link>'),
+      references="MuJoCo src/user/user_objects.cc (mjsGeom sizes must be positive); measured with MuJoCo 4.0.")
+def zero_size_collision(ctx) -> Iterator[Hit]:
+    for link in ctx.model.links:
+        for shape in link.collisions:
+            element = shape.geometry.element
+            keys = ZERO_SIZE_KEYS.get(shape.geometry.kind)
+            if element is None or keys is None:
+                continue
+            values = [value for key in keys for value in (parse_floats(element.get(key)) or ())]
+            if any(math.isfinite(value) and value <= 0 for value in values):  # non-finite and malformed: F007's
+                written = " ".join(f'{key}="{element.get(key)}"' for key in keys if element.get(key) is not None)
+                yield Hit(f"link '{link.name}' collision <{shape.geometry.kind} {written}/> has no size: MuJoCo "
+                          "refuses the file (size 0 must be positive in geom), PyBullet collides nothing there",
+                          element)
 
 
 @rule("G013", "hull-much-larger", "info", "Collision mesh much smaller than its convex hull",
