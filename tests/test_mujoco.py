@@ -69,12 +69,13 @@ def test_collada_and_missing_meshes_are_boxed_and_reported(tmp_path):
           <collision><geometry><mesh filename="gone.stl"/></geometry></collision>
           <collision><geometry><mesh filename="ascii.stl"/></geometry></collision>
           <collision><geometry><mesh filename="binary.stl"/></geometry></collision></link>"""))
-    result = run("lint-urdf", "--sim", "--engine", "all", "--select", "M", "--format", "json", str(path))
+    result = run("lint-urdf", "--sim", "--engine", "all", "--select", "M,G", "--format", "json", str(path))
     findings = json.loads(result.stdout)["findings"]
-    assert sorted(f["rule"] for f in findings) == ["M002", "M002", "M002"], result.stdout
-    messages = " ".join(f["message"] for f in findings)
-    assert "ASCII STL" in messages and "replaced by its 0.1 x 0.1 x 0.1 m box" in messages
-    assert "'gone.stl' is not found" in messages and "binary.stl" not in messages
+    by_rule = {rule: [f["message"] for f in findings if f["rule"] == rule] for rule in ("M002", "G001", "G011")}
+    (collada,) = by_rule["M002"]  # the missing and the ASCII mesh are G001's and G011's, said once
+    assert "part.dae" in collada and "is .dae: MuJoCo reads STL, OBJ and MSH meshes only" in collada
+    assert "gone.stl" in by_rule["G001"][0] and "ASCII STL" in by_rule["G011"][0]
+    assert "binary.stl" not in " ".join(f["message"] for f in findings)
 
 
 def test_same_named_meshes_in_two_folders_stay_two_meshes(tmp_path):

@@ -200,6 +200,18 @@ def refusal_explained(ctx, engine: str) -> str | None:
     return None
 
 
+def elements_reported(ctx, codes: tuple[str, ...]) -> set:
+    """The elements the static rules ``codes`` report in this file (once per file and list): an engine rule
+    whose finding would restate one of them at the same element leaves it to the static rule."""
+    def build(_model) -> set:
+        found = set()
+        for rule in registered():
+            if rule.code in codes and rule.check is not None and not rule.needs_sim:
+                found.update(hit.element for hit in rule.check(ctx) if hit.element is not None)
+        return found
+    return ctx.shared("reported:" + ",".join(codes), build)
+
+
 def engine_rule(code: str, name: str, severity: str, title: str, **docs: str) -> Rule:
     """A rule whose findings the engine produces (load failures), with no check of its own."""
     return rule(code, name, severity, title, **docs)(None)

@@ -13,7 +13,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
+from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, elements_reported, refusal_explained, robot, rule
 from ar3cli.lint.rules.pybullet_sim import unstable_hit
 
 SETTLE_SECONDS = 1.0
@@ -22,6 +22,9 @@ MAX_SETTLE_SPEED = 100.0
 PENETRATION = 1e-6
 """m: as P002 (``sim.session.PENETRATION_TOLERANCE``), contacts shallower than this are resting faces."""
 _COMPILED = "_ar3cli_mujoco"
+STATIC_MESH_RULES = ("G001", "G004", "G011", "F006")
+"""Static rules that already report a collision mesh MuJoCo cannot read (missing, unexpanded, a format or bytes
+no engine reads): M002 does not say it again."""
 
 
 def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
@@ -69,14 +72,19 @@ _STL = robot(f"""
       engines=("mujoco",),
       why="""MuJoCo reads STL, OBJ and MSH meshes only: a COLLADA (.dae) collision mesh, or one that is not found,
       stops its whole compile with "Error opening file". ar3cli replaces the mesh by its bounding box (or leaves
-      it out when its size is unknown) so the other checks still run, and says so here.""",
+      it out when its size is unknown) so the other checks still run, and says so here, for the meshes no
+      static rule reports already (G001 a missing mesh, F006 an unexpanded path, G004 a format, G011 bytes
+      no engine reads): in practice a COLLADA collision mesh, which PyBullet reads.""",
       fix="Export the collision mesh as STL or OBJ (keep the .dae for visuals, which MuJoCo discards).",
       bad=_DAE, good=_STL, needs_sim=True)
 def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
     robot, error = _compiled(ctx)
     if robot is None:
         return
+    known = elements_reported(ctx, STATIC_MESH_RULES)
     for substitution in robot.substitutions:
+        if substitution.element in known:
+            continue  # a missing, unexpanded, unreadable or unloadable mesh: the static rule says so at it
         yield Hit(f"link '{substitution.link}': {substitution.reason}; {substitution.replacement} for MuJoCo",
                   substitution.element)
 
