@@ -249,3 +249,10 @@ def test_mujocos_refusal_of_a_zero_size_collision_is_not_restated():
     pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
     findings = _lint("zero_size_collision.urdf", select=("G018", "M001"), sim=True, engines=("mujoco",))
     assert _codes(findings) == ["G018"]
+
+
+@pytest.mark.slow
+def test_stand_in_boxes_for_collada_meshes_make_no_contact_finding():
+    pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
+    findings = _lint("stand_in/robot.urdf", select=("M002", "M003"), sim=True, engines=("mujoco",))
+    assert _codes(findings) == ["M002", "M002"]  # each mesh's replacement is said; their boxes' overlap is not

@@ -94,7 +94,9 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
       why="""MuJoCo collides every pair of bodies but a parent and its child (no URDF_USE_SELF_COLLISION flag
       to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
       starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
-      fixed joints are not reported, as for P002.""",
+      fixed joints are not reported, as for P002. Nor is a pair where a link collides through a box ar3cli
+      put in place of a mesh MuJoCo cannot read (M002: a COLLADA collision mesh): boxes around concave
+      parts overlap where the parts do not, so such a contact says nothing about the robot.""",
       fix="Fix the collision geometry or the joint origin; if the overlap is by design, exclude the pair "
           "(<contact><exclude> in MJCF, or an SRDF for MoveIt).",
       bad=robot("""
@@ -121,10 +123,13 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     robot.set_positions(home_pose(ctx.model))
     adjacent = adjacent_pairs(ctx.model)
     group = rigid_groups(ctx.model, robot.joint_ids)
+    stand_ins = {substitution.link for substitution in robot.substitutions}
     for a, b, depth in robot.contacts(PENETRATION):
         if frozenset((a, b)) in adjacent or is_disabled(ctx.srdf_disabled, a, b) or \
                 (a in group and group[a] == group.get(b)):
             continue
+        if a in stand_ins or b in stand_ins:
+            continue  # a box ar3cli put in place of a mesh MuJoCo cannot read (M002): not the robot's shape
         link = ctx.model.link(b) or ctx.model.link(a)
         yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.3g} mm at the home pose in MuJoCo",
                   link.element if link else None)
