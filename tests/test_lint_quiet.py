@@ -256,3 +256,8 @@ def test_stand_in_boxes_for_collada_meshes_make_no_contact_finding():
     pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
     findings = _lint("stand_in/robot.urdf", select=("M002", "M003"), sim=True, engines=("mujoco",))
     assert _codes(findings) == ["M002", "M002"]  # each mesh's replacement is said; their boxes' overlap is not
+
+
+@pytest.mark.slow
+def test_a_torso_sliding_into_its_column_is_a_telescope():
+    assert _lint("telescopic_lift.urdf", select=("P005",), sim=True) == []

@@ -247,8 +247,10 @@ def _swinging_arm(limit: float) -> str:
       full turn; the other joints at home, mimic joints following) and measures how deep the child's
       collision geometry sinks into its parent's (the nearest ancestor with collision geometry). Real
       parent and child meshes overlap at the joint at every angle, by design: only the depth *added*
-      relative to the home pose counts. Children without collision geometry and prismatic joints without
-      limits are skipped; at most
+      relative to the home pose counts. Children without collision geometry are skipped, and so are
+      prismatic joints: a child sliding into its parent is how telescopic lifts, sleeves and retracting
+      poles are built (ARMAR-6's torso, R2-D2's gripper pole), which convex hulls cannot tell from a
+      solid. At most
       MAX_SWEPT_JOINTS = 64 joints are swept, so a huge robot stays fast.""",
       fix="Fix the joint limits (the child should stop where it meets its parent) or the collision geometry "
           "(a convex hull of a concave part fills its hollow: split it or use a simpler shape).",
