@@ -3,6 +3,7 @@ issue on a small fixture of tests/data/quiet/ (README.md there says where each p
 
 from __future__ import annotations
 
+import shutil
 from pathlib import Path
 
 import pytest
@@ -261,3 +262,16 @@ def test_stand_in_boxes_for_collada_meshes_make_no_contact_finding():
 @pytest.mark.slow
 def test_a_torso_sliding_into_its_column_is_a_telescope():
     assert _lint("telescopic_lift.urdf", select=("P005",), sim=True) == []
+
+
+@pytest.mark.slow
+def test_the_packages_own_srdf_disables_its_pairs_and_the_hint_says_so(tmp_path):
+    found = _by_file("srdf_package", sim=True)
+    assert "P002" not in _codes(found["arm.urdf"])  # srdf/arm.srdf disables base-tip
+    assert "P002" in _codes(found["other_arm.urdf"])  # no SRDF of its own
+    shutil.copytree(DATA / "srdf_package", tmp_path / "pkg")
+    (tmp_path / "pkg" / "srdf" / "arm.srdf").write_text(
+        '<robot name="arm"><disable_collisions link1="base" link2="mid" reason="User"/></robot>')
+    options = LintOptions(select=["P002"], sim=True)
+    (finding,) = lint_file(tmp_path / "pkg" / "urdf" / "arm.urdf", options.rules(), options).findings
+    assert "SRDF arm.srdf" in finding.hint and "--srdf" in finding.hint

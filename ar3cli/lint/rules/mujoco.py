@@ -14,7 +14,7 @@ from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, elements_reported, refusal_explained, robot, rule
-from ar3cli.lint.rules.pybullet_sim import unstable_hit
+from ar3cli.lint.rules.pybullet_sim import srdf_hint, unstable_hit
 
 SETTLE_SECONDS = 1.0
 MAX_SETTLE_SPEED = 100.0
@@ -89,16 +89,20 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
                   substitution.element)
 
 
+M003_FIX = ("Fix the collision geometry or the joint origin; if the overlap is by design, exclude the pair "
+            "(<contact><exclude> in MJCF, or an SRDF for MoveIt).")
+
+
 @rule("M003", "mujoco-self-collision-home", "warning", "Links collide in MuJoCo at the home pose",
       engines=("mujoco",),
       why="""MuJoCo collides every pair of bodies but a parent and its child (no URDF_USE_SELF_COLLISION flag
       to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
       starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
-      fixed joints are not reported, as for P002. Nor is a pair where a link collides through a box ar3cli
+      fixed joints are not reported, as for P002, nor the pairs an SRDF disables (--srdf, else the
+      package's own SRDF for this robot, as for P002). Nor is a pair where a link collides through a box ar3cli
       put in place of a mesh MuJoCo cannot read (M002: a COLLADA collision mesh): boxes around concave
       parts overlap where the parts do not, so such a contact says nothing about the robot.""",
-      fix="Fix the collision geometry or the joint origin; if the overlap is by design, exclude the pair "
-          "(<contact><exclude> in MJCF, or an SRDF for MoveIt).",
+      fix=M003_FIX,
       bad=robot("""
         <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
           <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
@@ -124,15 +128,16 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     adjacent = adjacent_pairs(ctx.model)
     group = rigid_groups(ctx.model, robot.joint_ids)
     stand_ins = {substitution.link for substitution in robot.substitutions}
+    disabled, note = ctx.disabled_pairs()
     for a, b, depth in robot.contacts(PENETRATION):
-        if frozenset((a, b)) in adjacent or is_disabled(ctx.srdf_disabled, a, b) or \
+        if frozenset((a, b)) in adjacent or is_disabled(disabled, a, b) or \
                 (a in group and group[a] == group.get(b)):
             continue
         if a in stand_ins or b in stand_ins:
             continue  # a box ar3cli put in place of a mesh MuJoCo cannot read (M002): not the robot's shape
         link = ctx.model.link(b) or ctx.model.link(a)
         yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.3g} mm at the home pose in MuJoCo",
-                  link.element if link else None)
+                  link.element if link else None, hint=srdf_hint(M003_FIX, note))
 
 
 @rule("M004", "mujoco-unstable", "error", "NaN or exploding states in MuJoCo after 1 s under gravity",

@@ -66,6 +66,10 @@ def sim_load_failed(ctx) -> Iterator[Hit]:
     body.remove()
 
 
+P002_FIX = ("Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
+                     "(SRDF / setCollisionFilterPair).")
+
+
 def _stacked_boxes(tip_z: float) -> str:
     """P002's example: base and tip boxes joined through a small middle link; overlapping when tip_z < 0."""
     return robot(f"""
@@ -87,9 +91,11 @@ def _stacked_boxes(tip_z: float) -> str:
       Adjacent is MoveIt's rule, as in sample-collisions: joined by a joint, looking through links
       without collision geometry (their overlap is by construction). Links joined only through
       fixed joints (one rigid group, as sample-collisions settles them) are not reported: they can
-      never move apart, so their overlap is how the part is built, not a pose to fix.""",
-      fix="Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
-          "(SRDF / setCollisionFilterPair).",
+      never move apart, so their overlap is how the part is built, not a pose to fix. Nor are the pairs
+      an SRDF disables: the one --srdf names, else the one the package ships for this robot (an .srdf
+      beside the file, or in srdf/ or config/ next to it or next to its urdf/ folder, named like the file
+      or naming the robot; the hint says which).""",
+      fix=P002_FIX,
       bad=_stacked_boxes(tip_z=-0.25), good=_stacked_boxes(tip_z=0.25),
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
@@ -102,14 +108,20 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
             return
         body.set_positions(home)
         group = rigid_groups(ctx.model, (joint.name for joint in body.actuated_joints))
+        disabled, note = ctx.disabled_pairs()
         for a, b, depth in nonadjacent_collisions(body):
-            if is_disabled(ctx.srdf_disabled, a, b):
-                continue  # the user's SRDF tells MoveIt not to check this pair
+            if is_disabled(disabled, a, b):
+                continue  # the SRDF (the user's, or the package's) tells MoveIt not to check this pair
             if a in group and group[a] == group.get(b):
                 continue  # joined only by fixed joints: they can never move apart (issue 30 item 8)
             link = ctx.model.link(b) or ctx.model.link(a)
             yield Hit(f"links '{a}' and '{b}' interpenetrate by {_depth_text(-depth)} at the home pose",
-                      link.element if link else None)
+                      link.element if link else None, hint=srdf_hint(P002_FIX, note))
+
+
+def srdf_hint(fix: str, note: str | None) -> str | None:
+    """A P002/M003 hint that says which SRDF's pairs were left out (None: the rule's own)."""
+    return None if note is None else f"{fix} ({note[0].upper()}{note[1:]}.)"
 
 
 def _depth_text(depth: float) -> str:
