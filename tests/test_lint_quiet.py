@@ -275,3 +275,15 @@ def test_the_packages_own_srdf_disables_its_pairs_and_the_hint_says_so(tmp_path)
     options = LintOptions(select=["P002"], sim=True)
     (finding,) = lint_file(tmp_path / "pkg" / "urdf" / "arm.urdf", options.rules(), options).findings
     assert "SRDF arm.srdf" in finding.hint and "--srdf" in finding.hint
+
+
+def _pairs(findings) -> set[tuple[str, str]]:
+    return {tuple(sorted(f.message.split("'")[1:4:2])) for f in findings}
+
+
+@pytest.mark.slow
+def test_contacts_a_robot_is_built_with_are_quiet_and_a_sunk_part_is_not():
+    arm = _lint("ball_joint_arm.urdf", select=("P002", "M003"), sim=True, engines=("pybullet", "mujoco"))
+    assert _pairs(arm) == {("forearm", "upper_arm")} and set(_codes(arm)) == {"P002", "M003"}
+    hand = _lint("linkage_hand.urdf", select=("P002", "M003"), sim=True, engines=("pybullet", "mujoco"))
+    assert _pairs(hand) == {("index", "thumb")}

@@ -14,7 +14,7 @@ from typing import Any
 
 from ar3cli.errors import UserError
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, elements_reported, refusal_explained, robot, rule
-from ar3cli.lint.rules.pybullet_sim import srdf_hint, unstable_hit
+from ar3cli.lint.rules.pybullet_sim import built_touching, srdf_hint, unstable_hit
 
 SETTLE_SECONDS = 1.0
 MAX_SETTLE_SPEED = 100.0
@@ -99,7 +99,8 @@ M003_FIX = ("Fix the collision geometry or the joint origin; if the overlap is b
       to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
       starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
       fixed joints are not reported, as for P002, nor the pairs an SRDF disables (--srdf, else the
-      package's own SRDF for this robot, as for P002). Nor is a pair where a link collides through a box ar3cli
+      package's own SRDF for this robot), nor the contacts a robot is built with (a joint cluster, one
+      linkage, two branches touching by at most 3 mm, a placeholder collision: P002 explains each). Nor is a pair where a link collides through a box ar3cli
       put in place of a mesh MuJoCo cannot read (M002: a COLLADA collision mesh): boxes around concave
       parts overlap where the parts do not, so such a contact says nothing about the robot.""",
       fix=M003_FIX,
@@ -115,7 +116,7 @@ M003_FIX = ("Fix the collision geometry or the joint origin; if the overlap is b
         <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 -0.25"/>
           <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
       good=arm(), needs_sim=True,
-      thresholds="Deeper than PENETRATION = 1e-6 m, as P002.")
+      thresholds="Deeper than PENETRATION = 1e-6 m; the contacts a robot is built with as for P002.")
 def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import adjacent_pairs, rigid_groups
     from ar3cli.sim.mujoco_session import home_pose
@@ -135,6 +136,8 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
             continue
         if a in stand_ins or b in stand_ins:
             continue  # a box ar3cli put in place of a mesh MuJoCo cannot read (M002): not the robot's shape
+        if built_touching(ctx, a, b, -depth) is not None:
+            continue
         link = ctx.model.link(b) or ctx.model.link(a)
         yield Hit(f"links '{a}' and '{b}' interpenetrate by {-depth * 1000:.3g} mm at the home pose in MuJoCo",
                   link.element if link else None, hint=srdf_hint(M003_FIX, note))
