@@ -120,6 +120,7 @@ EXTRA_FILES = {
     ("G011", "bad"): {"meshes/part.stl": ascii_stl()},
     ("G012", "bad"): {"meshes/flat.obj": (MESHES / "flat.obj").read_bytes()},
     ("G013", "bad"): {"meshes/u_shape.stl": u_shape_stl()},
+    ("M002", "bad"): {"part.dae": (MESHES / "cube_inches.dae").read_bytes()},  # found: a missing one is G001's
 }
 """Files a documented example needs beyond the standard meshes."""
 
