@@ -184,6 +184,7 @@ def test_a_macro_library_is_one_info_line_with_the_pybullet_rules_too():
 def test_a_frame_welded_to_the_root_is_the_bases_one_info_and_a_tool_frame_stays_a_warning():
     findings = [f for f in _lint("mounting_plate.urdf") if f.rule in ("I002", "I012")]
     assert [(f.rule, f.severity) for f in findings] == [("I012", Severity.INFO), ("I002", Severity.WARNING)]
+    assert findings[0].line == _line("mounting_plate.urdf", "<link name=\"base_link\">")  # the base it is about
     assert "'plate_top_centre'" in findings[0].message and "if this robot floats" in findings[0].message
     assert "'tool0'" in findings[1].message
 

@@ -625,7 +625,7 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
     elif welded:
         yield Hit(f"{len(welded)} link{'s' if len(welded) > 1 else ''} welded to root link '{root.name}' "
                   f"{'have' if len(welded) > 1 else 'has'} no <inertial> ({shown}): if this robot floats, PyBullet adds "
-                  "1 kg and I = 1 for each to its base", ctx.model.link(welded[0]).element,
+                  "1 kg and I = 1 for each to its base", root.element,
                   hint="If the robot floats: give each a tiny <inertial> (mass 1e-6 kg, I = 1e-12) or run ar3cli "
                        "fix-inertia; a fixed-base robot can ignore this.")
 
