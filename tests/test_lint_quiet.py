@@ -288,3 +288,12 @@ def test_contacts_a_robot_is_built_with_are_quiet_and_a_sunk_part_is_not():
     assert _pairs(arm) == {("forearm", "upper_arm")} and set(_codes(arm)) == {"P002", "M003"}
     hand = _lint("linkage_hand.urdf", select=("P002", "M003"), sim=True, engines=("pybullet", "mujoco"))
     assert _pairs(hand) == {("index", "thumb")}
+
+
+@pytest.mark.slow
+def test_mujocos_refusal_of_a_link_a_static_error_is_about_is_not_restated():
+    pytest.importorskip("mujoco", reason="MuJoCo is an optional extra")
+    restated = _lint("inertial_without_children.urdf", select=("S019", "M001"), sim=True, engines=("mujoco",))
+    assert _codes(restated) == ["S019", "S019"]  # MuJoCo's "missing element: 'mass'" is the same <inertial>
+    kept = _lint("planar_base.urdf", select=("I001", "I017", "M001"), sim=True, engines=("mujoco",))
+    assert "M001" in _codes(kept)  # virtual1 is an info for PyBullet; MuJoCo's refusal of it is news

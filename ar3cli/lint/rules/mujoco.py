@@ -13,7 +13,16 @@ from collections.abc import Iterator
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, elements_reported, refusal_explained, robot, rule
+from ar3cli.lint.rules.base import (
+    LINK_INERTIAL,
+    Hit,
+    arm,
+    elements_reported,
+    error_explained,
+    refusal_explained,
+    robot,
+    rule,
+)
 from ar3cli.lint.rules.pybullet_sim import built_touching, srdf_hint, unstable_hit
 
 SETTLE_SECONDS = 1.0
@@ -46,7 +55,9 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
       PyBullet's loader: a moving body whose mass or inertia is below mjMINVAL (a link without <inertial>
       and without collision geometry), an inertia breaking A + B >= C, a zero joint axis. ar3cli quotes
       MuJoCo's reason at the link or joint it names; when a static error that MuJoCo refuses (I005,
-      I006, J009, ...) already names the cause at its line, M001 adds nothing.""",
+      I006, J009, ...) already names the cause at its line, or a static error is about the very link
+      MuJoCo names (I001 on a link without <inertial>, S019 on an <inertial> without <inertia>), M001 adds
+      nothing.""",
       fix="Fix the reason quoted in the message (often an I or J finding of the same element).",
       bad=arm(link_extra=""), good=arm(), needs_sim=True,
       references="MuJoCo 4.0 user_objects.cc: 'mass and inertia of moving bodies must be larger than mjMINVAL'")
@@ -55,6 +66,8 @@ def mujoco_compile_failed(ctx) -> Iterator[Hit]:
 
     robot, error = _compiled(ctx)
     if error is not None and refusal_explained(ctx, "mujoco") is None:  # else a static error says why
+        if isinstance(error, MujocoCompileError) and error_explained(ctx, error.element) is not None:
+            return  # the link MuJoCo names is a static error's already (I001, S019: the same cause)
         if isinstance(error, MujocoCompileError):
             yield Hit(f"MuJoCo cannot compile it: {error.reason}",
                       error.element if error.element is not None else ctx.model.root)
