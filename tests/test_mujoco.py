@@ -48,9 +48,10 @@ def test_cross_check_stability_runs_both_engines_at_two_timesteps():
 
 def test_lint_engine_mujoco_maps_the_compile_error_to_the_link_line(tmp_path):
     from ar3cli.lint.rules.base import arm
+    from ar3cli.lint.rules.mujoco import TOO_LIGHT
 
     path = tmp_path / "r.urdf"
-    path.write_text(arm(link_extra=""))
+    path.write_text(arm(link_extra=TOO_LIGHT))  # a link without <inertial> is I001's: M001 would restate it
     result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M", "--format", "json", str(path))
     findings = json.loads(result.stdout)["findings"]
     (finding,) = [f for f in findings if f["rule"] == "M001"]
@@ -154,6 +155,12 @@ def test_mujoco_xml_error_points_at_the_users_line(tmp_path):
     text = arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/>\n    <origin xyz="0.07, 0, 0"/>')
     path.write_text(text)
     line = text.splitlines().index('    <origin xyz="0.07, 0, 0"/>') + 1
-    result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M001", "--format", "json", str(path))
-    (finding,) = json.loads(result.stdout)["findings"]
-    assert "bad format in attribute 'xyz'" in finding["message"] and finding["line"] == line
+    from ar3cli.sim.mujoco_session import MjRobot, MujocoCompileError
+    from ar3cli.urdf.model import load_model
+
+    with pytest.raises(MujocoCompileError) as refused:
+        MjRobot(load_model(path), fuse=False)
+    assert "bad format in attribute 'xyz'" in refused.value.reason and refused.value.element.sourceline == line
+    result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M001,F007", "--format", "json", str(path))
+    (finding,) = json.loads(result.stdout)["findings"]  # F007 says it at that line: M001 does not again
+    assert finding["rule"] == "F007" and finding["line"] == line

@@ -49,6 +49,11 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
 
 
 
+TOO_LIGHT = ('<inertial><mass value="1e-16"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+             '</inertial>')
+"""M001's example: a mass below mjMINVAL, which no static rule calls an error (I014 warns that it is light)."""
+
+
 @rule("M001", "mujoco-compile-failed", "error", "MuJoCo refuses to compile the model",
       engines=("mujoco",), refused_by=("mujoco",), breaks="MuJoCo refuses the file (measured: ar3cli compiles it).",
       why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
@@ -59,7 +64,7 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
       MuJoCo names (I001 on a link without <inertial>, S019 on an <inertial> without <inertia>), M001 adds
       nothing.""",
       fix="Fix the reason quoted in the message (often an I or J finding of the same element).",
-      bad=arm(link_extra=""), good=arm(), needs_sim=True,
+      bad=arm(link_extra=TOO_LIGHT), good=arm(), needs_sim=True,
       references="MuJoCo 4.0 user_objects.cc: 'mass and inertia of moving bodies must be larger than mjMINVAL'")
 def mujoco_compile_failed(ctx) -> Iterator[Hit]:
     from ar3cli.sim.mujoco_session import MujocoCompileError
