@@ -29,6 +29,15 @@ def fixed_child(link_extra: str, name: str = "flange") -> str:
         <joint name="{name}_joint" type="fixed"><parent link="base"/><child link="{name}"/></joint>""")
 
 
+def welded_to_arm(link_extra: str, name: str = "flange") -> str:
+    """A link welded to a moving arm (not to the root, whose welded frames are I012's)."""
+    return robot(f"""
+        <link name="base">{LINK_INERTIAL}</link><link name="arm">{LINK_INERTIAL}</link><link name="{name}">{link_extra}</link>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+          <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+        <joint name="{name}_joint" type="fixed"><parent link="arm"/><child link="{name}"/></joint>""")
+
+
 def mesh_link(filename: str, role: str = "collision", extra: str = "") -> str:
     return robot(f'<link name="part">{LINK_INERTIAL}<{role}{extra}><geometry><mesh filename="{filename}"/>'
                  f'</geometry></{role}></link>')

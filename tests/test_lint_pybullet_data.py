@@ -38,10 +38,11 @@ def test_random_urdfs_have_a_zero_principal_moment(pybullet_results):
 
 def test_known_findings_on_real_models(pybullet_results):
     kuka = _findings(pybullet_results, "kuka_iiwa/model_for_sdf.urdf")
-    assert sum(f.rule == "G001" for f in kuka) == 8 and "meshes/coarse/link_0.stl" in kuka[0].message
+    missing = [f for f in kuka if f.rule == "G001"]
+    assert len(missing) == 8 and "meshes/coarse/link_0.stl" in missing[0].message
     panda = _findings(pybullet_results, "franka_panda/panda.urdf")
     fingers = [f for f in panda if f.rule == "I007" and "finger" in f.message]
-    assert len(fingers) == 2 and all("32x" in f.message for f in fingers)
+    assert len(fingers) == 2 and all("31x" in f.message for f in fingers)  # against visual and collision: 0.0318 m
     assert {f.rule for f in _findings(pybullet_results, "r2d2.urdf")} >= {"J006"}
     laikago = _findings(pybullet_results, "laikago/laikago.urdf")
     assert sum(f.rule == "I006" for f in laikago) == 13  # all-zero tensors on every link

@@ -50,7 +50,10 @@ def write_fixture(folder: Path, text: str, files: dict[str, bytes] | None = None
 def codes_for(path: Path, code: str) -> list:
     rule = REGISTRY[code]
     # naming the code runs an opt-in rule; alone, because with both engines P002 and M003 on one pair are one finding
-    options = LintOptions(sim=rule.needs_sim, select=[code])
+    targets = LintOptions().targets
+    if rule.target_bound and not set(rule.engines) & set(targets):
+        targets = rule.engines  # a rule about MuJoCo only (G018) is linted for MuJoCo, where it has its severity
+    options = LintOptions(sim=rule.needs_sim, select=[code], targets=targets)
     return [f for f in lint_file(path, options.rules(), options).findings if f.rule == code]
 
 
@@ -118,6 +121,7 @@ EXTRA_FILES = {
     ("G011", "bad"): {"meshes/part.stl": ascii_stl()},
     ("G012", "bad"): {"meshes/flat.obj": (MESHES / "flat.obj").read_bytes()},
     ("G013", "bad"): {"meshes/u_shape.stl": u_shape_stl()},
+    ("M002", "bad"): {"part.dae": (MESHES / "cube_inches.dae").read_bytes()},  # found: a missing one is G001's
 }
 """Files a documented example needs beyond the standard meshes."""
 

@@ -58,9 +58,10 @@ def test_cross_check_stability_runs_both_engines_at_two_timesteps():
 
 def test_lint_engine_mujoco_maps_the_compile_error_to_the_link_line(tmp_path):
     from ar3cli.lint.rules.base import arm
+    from ar3cli.lint.rules.mujoco import TOO_LIGHT
 
     path = tmp_path / "r.urdf"
-    path.write_text(arm(link_extra=""))
+    path.write_text(arm(link_extra=TOO_LIGHT))  # a link without <inertial> is I001's: M001 would restate it
     result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M", "--format", "json", str(path))
     findings = json.loads(result.stdout)["findings"]
     (finding,) = [f for f in findings if f["rule"] == "M001"]
@@ -79,12 +80,13 @@ def test_collada_and_missing_meshes_are_boxed_and_reported(tmp_path):
           <collision><geometry><mesh filename="gone.stl"/></geometry></collision>
           <collision><geometry><mesh filename="ascii.stl"/></geometry></collision>
           <collision><geometry><mesh filename="binary.stl"/></geometry></collision></link>"""))
-    result = run("lint-urdf", "--sim", "--engine", "all", "--select", "M", "--format", "json", str(path))
+    result = run("lint-urdf", "--sim", "--engine", "all", "--select", "M,G", "--format", "json", str(path))
     findings = json.loads(result.stdout)["findings"]
-    assert sorted(f["rule"] for f in findings) == ["M002", "M002", "M002"], result.stdout
-    messages = " ".join(f["message"] for f in findings)
-    assert "ASCII STL" in messages and "replaced by its 0.1 x 0.1 x 0.1 m box" in messages
-    assert "'gone.stl' is not found" in messages and "binary.stl" not in messages
+    by_rule = {rule: [f["message"] for f in findings if f["rule"] == rule] for rule in ("M002", "G001", "G011")}
+    (collada,) = by_rule["M002"]  # the missing and the ASCII mesh are G001's and G011's, said once
+    assert "part.dae" in collada and "is .dae: MuJoCo reads STL, OBJ and MSH meshes only" in collada
+    assert "gone.stl" in by_rule["G001"][0] and "ASCII STL" in by_rule["G011"][0]
+    assert "binary.stl" not in " ".join(f["message"] for f in findings)
 
 
 def test_same_named_meshes_in_two_folders_stay_two_meshes(tmp_path):
@@ -180,6 +182,12 @@ def test_mujoco_xml_error_points_at_the_users_line(tmp_path):
     text = arm().replace('<axis xyz="0 0 1"/>', '<axis xyz="0 0 1"/>\n    <origin xyz="0.07, 0, 0"/>')
     path.write_text(text)
     line = text.splitlines().index('    <origin xyz="0.07, 0, 0"/>') + 1
-    result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M001", "--format", "json", str(path))
-    (finding,) = json.loads(result.stdout)["findings"]
-    assert "bad format in attribute 'xyz'" in finding["message"] and finding["line"] == line
+    from ar3cli.sim.mujoco_session import MjRobot, MujocoCompileError
+    from ar3cli.urdf.model import load_model
+
+    with pytest.raises(MujocoCompileError) as refused:
+        MjRobot(load_model(path), fuse=False)
+    assert "bad format in attribute 'xyz'" in refused.value.reason and refused.value.element.sourceline == line
+    result = run("lint-urdf", "--sim", "--engine", "mujoco", "--select", "M001,F007", "--format", "json", str(path))
+    (finding,) = json.loads(result.stdout)["findings"]  # F007 says it at that line: M001 does not again
+    assert finding["rule"] == "F007" and finding["line"] == line

@@ -10,7 +10,7 @@ from __future__ import annotations
 from ar3cli.findings import Severity
 from ar3cli.lint.rules import FAMILY_ORDER, REGISTRY, RULES, inertia
 from ar3cli.lint.rules.base import LINK_INERTIAL, arm, robot
-from tests.lint_helpers import findings, fixed_child, tensor
+from tests.lint_helpers import findings, fixed_child, tensor, welded_to_arm
 from tests.test_lint_rules import codes_for, write_fixture
 
 # ---- I006 / I008: zero tensors, moving or welded; effectively zero --------------------------------------
@@ -127,10 +127,10 @@ def test_metadata_reaches_the_docs_and_the_rule_object():
 def test_fix_hint_asks_no_density_for_frame_links(tmp_path):
     from ar3cli.lint.fix_hints import fix_commands
 
-    frame_only = findings(write_fixture(tmp_path / "frame", fixed_child("")))
+    frame_only = findings(write_fixture(tmp_path / "frame", welded_to_arm("")))
     assert [f.rule for f in frame_only if f.rule.startswith("I")] == ["I002"]
     assert fix_commands("robot.urdf", frame_only) == ["ar3cli fix-inertia robot.urdf  # I002"]
-    part = findings(write_fixture(tmp_path / "part", fixed_child(
+    part = findings(write_fixture(tmp_path / "part", welded_to_arm(
         '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>')))
     assert fix_commands("robot.urdf", [f for f in part if f.rule == "I002"]) == [
         "ar3cli fix-inertia robot.urdf --density KG_PER_M3  # I002"]

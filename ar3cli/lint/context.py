@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from typing import Any, TypeVar
 
 from ar3cli.maths.tensor_math import symmetric_eigenvalues
-from ar3cli.urdf.bounds import Box, link_bounds, scaled_mesh_bounds, shape_bounds
+from ar3cli.urdf.bounds import Box, box_around, box_union, link_bounds, scaled_mesh_bounds, shape_bounds
 from ar3cli.urdf.model import Link, Model, Shape
 
 T = TypeVar("T")
@@ -58,6 +58,27 @@ class Context:
         self._session: Any = None
         self._shared: dict[str, Any] = {}
 
+    def disabled_pairs(self) -> tuple[frozenset[frozenset[str]], str | None]:
+        """(the link pairs MoveIt is told not to check, a note saying where they come from or None): the
+        user's ``--srdf``, else the SRDF the package ships for this robot
+        (:func:`~ar3cli.urdf.srdf_read.package_srdf`), else none. P002 and M003 leave those pairs alone."""
+        if "disabled-pairs" not in self._shared:
+            found: tuple[frozenset[frozenset[str]], str | None] = (self.srdf_disabled, None)
+            if not self.srdf_disabled:
+                from ar3cli.errors import UserError
+                from ar3cli.urdf.srdf_read import disabled_pairs, package_srdf
+
+                path = package_srdf(self.model.path, self.model.name, {link.name for link in self.model.links})
+                if path is not None:
+                    try:
+                        pairs = disabled_pairs(path)
+                        found = (pairs, f"pairs disabled by the package's SRDF {path.name} (found beside the file "
+                                        "for this robot; --srdf FILE chooses another) are not reported")
+                    except UserError:
+                        pass
+            self._shared["disabled-pairs"] = found
+        return self._shared["disabled-pairs"]
+
     def shared(self, key: str, build: Callable[[Model], T]) -> T:
         """``build(model)``, computed once per file for every rule that asks with the same ``key``
         (the schema rules' walk of the URDF elements: five rules, one walk)."""
@@ -70,6 +91,17 @@ class Context:
         if link.name not in self._bounds:
             self._bounds[link.name] = link_bounds(link, self.shape_bounds)
         return self._bounds[link.name]
+
+    def body_bounds(self, link: Link) -> Box | None:
+        """Box around every visual and collision shape of the link, in its frame, or None: the body's extent
+        whichever of its shapes stands for it (Baxter's screen collides as a 1 mm placeholder sphere and is
+        drawn as its real 27 cm body). What a radius of gyration is judged against (I007)."""
+        key = "body:" + link.name
+        if key not in self._bounds:
+            boxes = [box for shape in (*link.visuals, *link.collisions) if (box := self.shape_bounds(shape)) is not None]
+            finite = boxes and all(all(map(math.isfinite, corner)) for box in boxes for corner in box)
+            self._bounds[key] = box_union(boxes) if finite else None
+        return self._bounds[key]
 
     def shape_bounds(self, shape: Shape) -> Box | None:
         """Box around one visual or collision shape in its link's frame, or None; computed once per
@@ -175,6 +207,64 @@ class Context:
                 for j in range(3):
                     composite[i][j] += turned[i][j] + mass * ((square if i == j else 0.0) - d[i] * d[j])
         return total, symmetric_eigenvalues(composite)
+
+    def zero_pose_frame(self, name: str) -> tuple[Matrix, tuple[float, float, float]] | None:
+        """(rotation, origin) of link ``name``'s frame in its root link's frame with every joint at 0 (the
+        joint origins composed down the tree), or None for a link no root reaches or one below a joint
+        origin that is not finite. Computed for every link once per file."""
+        if "zero-pose-frames" not in self._shared:
+            self._shared["zero-pose-frames"] = self._zero_pose_frames()
+        return self._shared["zero-pose-frames"].get(name)
+
+    def _zero_pose_frames(self) -> dict[str, tuple[Matrix, tuple[float, float, float]]]:
+        model = self.model
+        frames: dict[str, tuple[Matrix, tuple[float, float, float]]] = {}
+        stack = [link.name for link in model.root_links()]
+        for name in stack:
+            frames[name] = (IDENTITY, (0.0, 0.0, 0.0))
+        while stack:
+            name = stack.pop()
+            rotation, origin = frames[name]
+            for joint in model.child_joints(name):
+                child = joint.child
+                if child is None or child in frames or model.link(child) is None:
+                    continue  # a link reached twice or a loop: S006's
+                values = (*joint.origin.xyz, *(v for row in joint.origin.rotation for v in row))
+                if not all(map(math.isfinite, values)):
+                    continue
+                frames[child] = (_matmul(rotation, joint.origin.rotation), _apply(rotation, joint.origin.xyz, origin))
+                stack.append(child)
+        return frames
+
+    def zero_pose_box(self, name: str, box: Box | None) -> Box | None:
+        """``box`` (in link ``name``'s frame) as an axis-aligned box in its root's frame at the zero pose
+        (:meth:`zero_pose_frame`), or None when either is unknown: where two links' shapes sit relative
+        to each other, without a simulator."""
+        frame = self.zero_pose_frame(name)
+        if box is None or frame is None:
+            return None
+        centre = [(lo + hi) / 2 for lo, hi in zip(*box)]
+        half = [(hi - lo) / 2 for lo, hi in zip(*box)]
+        return box_around(centre, half, frame[0], frame[1])
+
+    def kinematic_span(self) -> float:
+        """Metres the robot's own joints span: the longest prismatic travel or the furthest link frame
+        from its root at the zero pose, whichever is more (0 for a robot of one link). What a size is
+        judged against besides the parts: a gantry whose rail travels 37 m is a building-sized robot, and
+        its 46 m rail is metres, not millimetres."""
+        if "kinematic-span" not in self._shared:
+            span = 0.0
+            for joint in self.model.joints:
+                limit = joint.limit
+                if joint.type == "prismatic" and limit is not None and limit.lower is not None \
+                        and limit.upper is not None and math.isfinite(limit.upper - limit.lower):
+                    span = max(span, limit.upper - limit.lower)
+            for link in self.model.links:
+                frame = self.zero_pose_frame(link.name)
+                if frame is not None:
+                    span = max(span, math.hypot(*frame[1]))
+            self._shared["kinematic-span"] = span
+        return self._shared["kinematic-span"]
 
     @property
     def session(self) -> Any:

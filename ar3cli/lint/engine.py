@@ -222,12 +222,13 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     """
     from ar3cli.infra import process_pool
     from ar3cli.infra.streaming_pool import stream
+    from ar3cli.lint.included import merge_included
 
     rules = options.rules()
     cache = _result_cache(options, rules) if use_cache else None
     files = collect_files(paths, skipped)
     if not process_pool.can_fork():  # Windows, macOS: in this process, without limits
-        return [settle(lint_file(path, rules, options, cache), options) for path in files]
+        return merge_included([settle(lint_file(path, rules, options, cache), options) for path in files])
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
     take_learned()  # what this process knows already need not come back from every child
@@ -245,7 +246,7 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
             result = LintResult(display_path(files[index]), False, [], _stopped(display_path(files[index]), kind,
                                                                                  payload, limit))
         results[index] = settle(result, options)
-    return results
+    return merge_included(results)
 
 
 def file_time_limit(options: LintOptions) -> float | None:
@@ -389,7 +390,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
             data = read_bytes(path)
         model = load_model(path, options.package_paths, options.xacro_args, source=data)
     except UserError as exc:
-        finding = load_failure(path, shown, exc.message)
+        finding = included_failure(path, load_failure(path, shown, exc.message))
     except RecursionError:
         finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
     except MemoryError:
@@ -544,6 +545,23 @@ def internal_error(where: str, exc: BaseException) -> str:
     return f"internal error {where} ({type(exc).__name__}{': ' + text if text else ''}), please report it"
 
 
+def included_failure(path: Path, failure: Finding) -> Finding:
+    """``failure``, or F008 at info when it is an F004 of a xacro library or of a fragment a file of its
+    package includes (:func:`~ar3cli.lint.rules.file.fragment_message`): the includer reports it."""
+    from ar3cli.infra.safe_read import read_bytes
+    from ar3cli.lint.rules.file import fragment_message
+
+    if failure.rule != "F004":
+        return failure
+    try:
+        message = fragment_message(path, read_bytes(path), failure.message)
+    except UserError:
+        return failure
+    if message is None:
+        return failure
+    return Finding(LIBRARY, REGISTRY[LIBRARY].severity, message, failure.path, 0, 0, REGISTRY[LIBRARY].fix)
+
+
 def load_failure(path: Path, shown: str, message: str) -> Finding:
     """Turn the loader's one-line UserError into an F001-F004 finding on the file."""
     line = 0
@@ -553,11 +571,11 @@ def load_failure(path: Path, shown: str, message: str) -> Finding:
             line = int(match.group(1) or 0)
             message = message[match.end():]
             break
-    if any(key in message for key in ("no such file", "is a directory", "not a regular file", "cannot read",
-                                      "MB limit")):
+    if "xacro error" in message or "$(find" in message:
+        code = "F004"  # an include xacro cannot read is the expansion's failure, not the file's
+    elif any(key in message for key in ("no such file", "is a directory", "not a regular file", "cannot read",
+                                        "MB limit")):
         code = "F001"
-    elif "xacro error" in message or "$(find" in message:
-        code = "F004"
     elif message.startswith("root element is"):
         code = "F003"
     else:

@@ -8,7 +8,7 @@ sweep step minus the depth at the home pose.
 
 The sweep: every driving joint in pybullet order (at most :data:`MAX_SWEPT_JOINTS`), at
 :data:`SWEEP_STEPS` evenly spaced values over its range, limits included (continuous and unlimited
-revolute joints over a full turn, prismatic joints without limits not at all), the other joints at
+revolute joints over a full turn, prismatic joints not at all: :data:`TELESCOPES`), the other joints at
 home, mimic joints following. At each step the child of the swept joint (and of each mimic joint
 that follows it) is tested against its parent with ``getClosestPoints``. Links without collision
 geometry are looked through (the parent is the nearest ancestor with geometry) and, as the child,
@@ -27,6 +27,11 @@ import numpy as np
 from ar3cli.sim.adjacency import collision_links
 from ar3cli.sim.sampling import joint_space
 
+TELESCOPES = ("prismatic",)
+"""Joint types not swept: a prismatic joint slides its child along its axis, and into its parent is how a
+telescopic lift, a sleeve or a retracting pole is built (ARMAR-6's torso sinks 0.365 m into its platform's
+column, R2-D2's gripper pole retracts into the body); convex hulls cannot tell a sleeve from a solid, so the
+depth it adds says nothing about the robot."""
 SWEEP_STEPS = 13
 """Values per joint, both limits included (a step of 30 degrees over a full turn)."""
 MAX_SWEPT_JOINTS = 64
@@ -104,8 +109,8 @@ def pass_throughs(body: Any) -> Iterator[PassThrough]:
     home_driving = space.home[list(space.driving)]
     for position, column in enumerate(space.driving[:MAX_SWEPT_JOINTS]):
         joint = joints[column]
-        if joint.urdf_type == "prismatic" and joint.lower is None:
-            continue
+        if joint.urdf_type in TELESCOPES:
+            continue  # a slider into its parent is a telescope, a sleeve or a retracting pole
         driving = np.tile(home_driving, (SWEEP_STEPS, 1))
         driving[:, position] = _sweep_values(space.lower[position], space.upper[position], space.continuous[position])
         configurations = space.fill(driving)

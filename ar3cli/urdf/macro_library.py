@@ -22,6 +22,9 @@ DEFINITIONS = frozenset({"macro", "property", "arg", "include"})
 """xacro elements that define something and make no robot element themselves."""
 CONDITIONALS = frozenset({"if", "unless"})
 """xacro elements whose children count as if written in their place."""
+LEGACY_DEFINITIONS = frozenset({"property", "macro"})
+"""xacro definitions written without the namespace prefix, as xacro before ROS Jade read them: no URDF element
+has these names, so a top-level <property> is a library's, not a robot's."""
 LIBRARY_URDF_ELEMENTS = frozenset({"material"})
 """URDF elements a library may hold at the top level (a materials.xacro)."""
 MAX_CANDIDATES = 400
@@ -72,21 +75,34 @@ def macro_library(model, find_includers: bool = True) -> MacroLibrary | None:
     (``macro``, ``property``, ``arg``, ``include``, also inside ``if``/``unless``) and ``<material>``s, at
     least one macro, property or material, and no macro call: a file that calls a macro and gets
     nothing out of it is a robot whose expansion went wrong, and is linted as one. ``find_includers``
-    looks for the files that include it (:func:`_includers`)."""
+    looks for the files that include it (:func:`includers`)."""
     if model.links or model.joints:
         return None
-    root = model.root
-    if model.is_xacro:
-        try:
-            root, _ = xmlsource.parse(xmlsource.normalize(model.source_bytes)[0], model.path)
-        except UserError:
-            return None
+    if not model.is_xacro:
+        return library_in_root(model.root, model.path, find_includers)
+    return library_in_source(model.source_bytes, model.path, find_includers)
+
+
+def library_in_source(source: bytes, path: Path, find_includers: bool = True) -> MacroLibrary | None:
+    """:func:`macro_library` from a xacro file's source alone, for a file whose expansion failed (a library
+    that includes ``$(find pkg)/...``, which only its includer's workspace resolves)."""
+    try:
+        root, _ = xmlsource.parse(xmlsource.normalize(source)[0], path)
+    except UserError:
+        return None
+    return library_in_root(root, path, find_includers)
+
+
+def library_in_root(root, path: Path, find_includers: bool = True) -> MacroLibrary | None:
+    """:func:`macro_library` from the parsed source's root element."""
     macros: list[str] = []
     counts = {"property": 0, "material": 0}
     stack = [child for child in root if isinstance(child.tag, str)]
     while stack:
         element = stack.pop()
         xacro, local = _is_xacro(element.tag)
+        if not xacro and local in LEGACY_DEFINITIONS:
+            xacro = True  # pre-namespace xacro: <property name="pi" .../> (rtb-data's KUKA macros)
         if xacro and local in CONDITIONALS:
             stack.extend(child for child in element if isinstance(child.tag, str))
         elif xacro and local == "macro":
@@ -100,10 +116,10 @@ def macro_library(model, find_includers: bool = True) -> MacroLibrary | None:
     if not macros and not counts["property"] and not counts["material"]:
         return None
     return MacroLibrary(tuple(sorted(macros)), counts["property"], counts["material"],
-                        _includers(model.path) if find_includers else ())
+                        includers(path) if find_includers else ())
 
 
-def _includers(path: Path) -> tuple[str, ...]:
+def includers(path: Path) -> tuple[str, ...]:
     """The robot files that include a file of ``path``'s name, looked for in its package (the nearest
     folder with a package.xml, at most MAX_LEVELS above) or, outside a package, in its own folder tree:
     where ar3cli may read anyway (docs/security.md). A hint, so the search is bounded (MAX_FOLDERS

@@ -412,7 +412,7 @@ def load_model(
     else:
         xml_bytes, quirks = xmlsource.normalize(source)
     root, parse_quirks = xmlsource.parse(xml_bytes, path)
-    quirks.extend(parse_quirks)
+    quirks.extend(xmlsource.source_lines(parse_quirks, source) if is_xacro(path) else parse_quirks)
     if not isinstance(root.tag, str) or root.tag != "robot":
         raise UserError(f"{path}:{root.sourceline or 1}: root element is <{root.tag}>, expected <robot>; "
                         "is this a URDF file?")

@@ -53,8 +53,8 @@ class Resolution:
     def found(self) -> bool:
         return self.path is not None
 
-    def places(self) -> str:
-        """Where the search looked, for a message (:func:`shown_places`)."""
+    def places(self) -> list[str]:
+        """Where the search looked, as a message may show it (:func:`shown_places`)."""
         return shown_places(self.tried, self.folder)
 
     def explain(self) -> str:
@@ -63,11 +63,11 @@ class Resolution:
             return f"{self.uri} -> {self.path}"
         reason = self.problem or "not found"
         if self.tried:
-            return f"{self.uri}: {reason}; tried {self.places()}"
+            return f"{self.uri}: {reason}; tried {', '.join(self.places())}"
         return f"{self.uri}: {reason}"
 
 
-def shown_places(places: Sequence[str], folder: str | os.PathLike[str]) -> str:
+def shown_places(places: Sequence[str], folder: str | os.PathLike[str]) -> list[str]:
     """The places a search tried, as a message shows them: those inside the current folder (relative
     to it) or inside the robot's ``folder``, in order; the others (the folders above the checkout,
     ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` entries) only counted. Their names are the
@@ -89,7 +89,7 @@ def shown_places(places: Sequence[str], folder: str | os.PathLike[str]) -> str:
             hidden += 1
     if hidden:
         shown.append(f"{hidden} place{'s' if hidden != 1 else ''} outside the robot's folder")
-    return ", ".join(shown)
+    return shown
 
 
 ANCESTORS = "ancestors of the robot's folder"

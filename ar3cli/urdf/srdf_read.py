@@ -132,3 +132,52 @@ def disabled_pairs(path: Path) -> frozenset[frozenset[str]]:
 def is_disabled(pairs: frozenset[frozenset[str]], a: str, b: str) -> bool:
     """Whether ``disabled_pairs`` covers the pair (a, b)."""
     return frozenset((a, b)) in pairs or frozenset((a,)) in pairs or frozenset((b,)) in pairs
+
+
+PACKAGE_FOLDERS = ("urdf", "robots")
+"""Folder names of a ROS package's robot files: their parent is the package's root, where srdf/ and config/
+(and a loose SRDF) live."""
+SRDF_FOLDERS = ("", "srdf", "config")
+"""Where a package keeps its SRDF, relative to the robot file's folder (and, in a PACKAGE_FOLDERS layout, to
+its parent)."""
+MAX_SRDF_CANDIDATES = 64
+"""SRDF files read when the package's SRDF is looked for (a hint: bounded)."""
+
+
+def package_srdf(urdf_path: Path, robot_name: str | None, links: set[str]) -> Path | None:
+    """The SRDF a package ships for this robot file, or None: an ``*.srdf`` in the file's folder or its
+    ``srdf/`` or ``config/`` subfolder (and the same beside a ``urdf/`` or ``robots/`` folder, the package's
+    root in ROS's layout), whose file name is the robot file's (``panda.srdf`` for ``panda.urdf``), else whose
+    ``<robot name>`` is the robot's, else whose file name is the robot's name (``vega_1p_gripper.srdf`` for
+    a collision-spheres variant of that robot). Exactly one candidate of the first kind that has any must
+    match, and its disabled pairs must name links of this robot; an SRDF that cannot be read is skipped.
+    Used by ``lint-urdf --sim`` when no ``--srdf`` is given (compas-fab, dexmate-urdf and pyroboplan ship
+    one beside each URDF)."""
+    folder = urdf_path.parent
+    roots = [folder] + ([folder.parent] if folder.name in PACKAGE_FOLDERS and folder.parent != folder else [])
+    candidates: list[Path] = []
+    for root in roots:
+        for sub in SRDF_FOLDERS:
+            place = root / sub if sub else root
+            try:
+                candidates += sorted(p for p in place.iterdir() if p.suffix.lower() == ".srdf" and p.is_file())
+            except OSError:
+                continue
+    stem = urdf_path.name.split(".", 1)[0]
+    read: list[tuple[Path, Srdf]] = []
+    for candidate in list(dict.fromkeys(candidates))[:MAX_SRDF_CANDIDATES]:
+        try:
+            read.append((candidate, read_srdf(candidate)))
+        except UserError:
+            continue
+    for matches in (lambda path, srdf: path.stem == stem,
+                    lambda path, srdf: robot_name is not None and srdf.robot_name == robot_name,
+                    lambda path, srdf: robot_name is not None and path.stem == robot_name):
+        found = [(path, srdf) for path, srdf in read if matches(path, srdf)]
+        if found:
+            if len(found) != 1:
+                return None  # several fit equally: none is the robot's for sure
+            path, srdf = found[0]
+            named = {link for entry in srdf.entries for link in (entry.link1, entry.link2)} | set(srdf.no_default)
+            return path if named & links else None
+    return None

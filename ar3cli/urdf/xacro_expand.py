@@ -202,7 +202,7 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
         folder, tried = resolver.find_package(name)
         if folder is None:
             failures.append(UserError(f"{path}: $(find {name}): package not found; tried "
-                                      f"{shown_places(tried, resolver.base_dir)}; "
+                                      f"{', '.join(shown_places(tried, resolver.base_dir))}; "
                                       f"pass --package-path {name}=DIR"))
             raise failures[-1]
         roots.add_package(folder)

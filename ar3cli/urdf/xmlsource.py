@@ -170,6 +170,21 @@ def _declare_undeclared_prefixes(data: bytes, quirks: list[Quirk]) -> bytes:
     return data[:root.end()] + declarations + data[root.end():]
 
 
+def source_lines(quirks: list[Quirk], source: bytes) -> list[Quirk]:
+    """The quirks found parsing a xacro file's expansion, at lines of its source: an undeclared prefix at
+    its first use in the source (or line 0 when only an included file uses it), any other at line 0 (the
+    expansion's line numbers are not the file's: ridgeback.urdf.xacro's 393 of a 332-line file)."""
+    placed = []
+    for quirk in quirks:
+        line = 0
+        if quirk.code == "undeclared-prefix":
+            found: list[Quirk] = []
+            _declare_undeclared_prefixes(normalize(source)[0], found)
+            line = found[0].line if found else 0
+        placed.append(Quirk(quirk.code, quirk.message, line))
+    return placed
+
+
 _UNPARSED = ((b"<!--", b"-->"), (b"<![CDATA[", b"]]>"))
 """Where XML text is not markup: comments and CDATA sections."""
 

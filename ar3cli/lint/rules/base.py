@@ -200,6 +200,42 @@ def refusal_explained(ctx, engine: str) -> str | None:
     return None
 
 
+def error_explained(ctx, element) -> str | None:
+    """The code of a static rule that reports an error at ``element`` or inside it (for this file's targets),
+    or None: an engine's refusal that names the link a static error is about (MuJoCo's "mjMINVAL (link
+    'odom_tx')" where I001 says the link has no <inertial>) adds nothing to it. Once per file."""
+    from ar3cli.findings import Severity
+
+    if element is None:
+        return None
+    def build(_model) -> dict:
+        found: dict = {}
+        for rule in registered():
+            if rule.check is None or rule.needs_sim or rule.severity_for(ctx.targets) is not Severity.ERROR:
+                continue
+            for hit in rule.check(ctx):
+                if hit.element is not None:
+                    found.setdefault(hit.element, rule.code)
+        return found
+    reported = ctx.shared("error-elements", build)
+    for node in element.iter():
+        if node in reported:
+            return reported[node]
+    return None
+
+
+def elements_reported(ctx, codes: tuple[str, ...]) -> set:
+    """The elements the static rules ``codes`` report in this file (once per file and list): an engine rule
+    whose finding would restate one of them at the same element leaves it to the static rule."""
+    def build(_model) -> set:
+        found = set()
+        for rule in registered():
+            if rule.code in codes and rule.check is not None and not rule.needs_sim:
+                found.update(hit.element for hit in rule.check(ctx) if hit.element is not None)
+        return found
+    return ctx.shared("reported:" + ",".join(codes), build)
+
+
 def engine_rule(code: str, name: str, severity: str, title: str, **docs: str) -> Rule:
     """A rule whose findings the engine produces (load failures), with no check of its own."""
     return rule(code, name, severity, title, **docs)(None)

@@ -204,7 +204,36 @@ def collision_off(ctx, link) -> tuple[float, float, Box, Box] | None:
     if found is None or scale_mismatches(ctx, link):  # a mesh in the wrong unit is G006's
         return None
     covered, offset, visual, _collision = found
-    return found if covered < COVER_MIN and offset > max(OFFSET_MIN, OFFSET_FACTOR * _diagonal(visual) / 2) else None
+    if covered >= COVER_MIN or offset <= max(OFFSET_MIN, OFFSET_FACTOR * _diagonal(visual) / 2):
+        return None
+    return None if _covered_by_companion(ctx, link, visual) else found
+
+
+def _companions(ctx, link):
+    """Links with collision shapes and no visual welded (fixed joint) to ``link`` or to its parent: where
+    a description keeps a part's collision on a link of its own (Rethink's Baxter: ``right_upper_elbow``'s
+    cylinder is on ``right_upper_elbow_visual``, welded to the parent at the elbow joint)."""
+    model = ctx.model
+    joint = model.parent_joint(link.name)
+    anchors = [link.name] + ([joint.parent] if joint is not None and joint.parent else [])
+    for anchor in anchors:
+        for other_joint in model.child_joints(anchor):
+            other = model.link(other_joint.child) if other_joint.type == "fixed" and other_joint.child else None
+            if other is not None and other is not link and other.collisions and not other.visuals:
+                yield other
+
+
+def _covered_by_companion(ctx, link, visual: Box) -> bool:
+    """True when a companion link's collision (:func:`_companions`) covers COVER_MIN of ``link``'s visual
+    box at the zero pose."""
+    placed = ctx.zero_pose_box(link.name, visual)
+    if placed is None:
+        return False
+    for other in _companions(ctx, link):
+        box = ctx.zero_pose_box(other.name, _union(ctx.shape_bounds(s) for s in other.collisions))
+        if box is not None and _overlap_fraction(placed, box) >= COVER_MIN:
+            return True
+    return False
 
 
 def _visual_and_collision(collision_xyz: str) -> str:
@@ -218,7 +247,9 @@ def _visual_and_collision(collision_xyz: str) -> str:
       why="""The collision shapes are what the simulator and the planner see; the visual shapes are
       what people see. When their boxes barely overlap and their centres are apart (a collision
       <origin> forgotten, pasted from another link, or a misspelt <orign> ignored), the robot collides
-      where nothing is drawn and passes through what is drawn.""",
+      where nothing is drawn and passes through what is drawn. A part whose collision lives on a
+      companion link (a link with collision and no visual, welded to the part or to its parent, as
+      Rethink's Baxter does for its elbows) is judged with that collision too.""",
       fix="Give the <collision> the same <origin> as the <visual>, and check its spelling (<orign> is ignored).",
       bad=_visual_and_collision("0.3 0 0"), good=_visual_and_collision("0 0 0"),
       thresholds=f"Reported when the collision box covers less than {COVER_MIN:.0%} of the visual box and their "

@@ -43,7 +43,12 @@ engine `--engine` chose and keep their severity; the T rules run only for their 
 **One cause, one finding.** Where one mistake would trip several rules, one rule reports it and its
 message lists the consequences: an unexpanded mesh path is F006's (not also G001's), a joint that
 cannot move is J004's (not also J008's), a tensor that is not a body's is I004's or I005's (not also
-I007's), an `<inertial>` missing both children is one S019 finding.
+I007's), an `<inertial>` missing both children is one S019 finding. An engine rule does not restate a
+static one: P001 and M001 stay quiet when a static error already says why the engine refuses the file,
+M002 about a mesh G001, F006, G004 or G011 reports. A frame welded to the root is the base's, listed in
+its one I012 finding (not an I002 each). A xacro library or include body that does not expand alone is
+one F008 line (its includer reports the failure), and a macro file's finding is reported once in a
+folder lint, however many linted files include it.
 """
 
 

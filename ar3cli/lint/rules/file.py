@@ -188,13 +188,16 @@ LIBRARY = "F008"
 """The code of a xacro library's one line (:func:`macro_library_file`): the engine runs it alone on such a file."""
 
 
-@rule(LIBRARY, "macro-library", "info", "A xacro library: macros, no robot",
+@rule(LIBRARY, "macro-library", "info", "A xacro library or fragment: checked where it is included",
       why="""A robot's urdf/ folder holds one entry file and files that only define xacro macros (or
       properties, or materials) for it to include: leg.xacro, utils/*.xacro, materials.xacro. Such a
       file instantiates no robot, so it has no name, no links and no joints of its own, and every
       robot rule would call it broken. Its content is checked where an entry file includes it: the
       entry file's findings point at this file's lines. This one line says so, and names the files of
-      its package that include it.""",
+      its package that include it. The same holds for a fragment that does not expand alone because it
+      reads what its includer defines ($(arg model_dir) declared by the entry file, a $(find pkg) only
+      its workspace resolves): when a file of its package includes it, the expansion's failure is the
+      includer's to report (xacro stops there too), and this line names the includer and the reason.""",
       fix="Nothing to fix here: lint the entry file that includes it (lint-urdf on the folder does).",
       bad='''<?xml version="1.0"?>
 <robot xmlns:xacro="http://www.ros.org/wiki/xacro">
@@ -205,15 +208,55 @@ LIBRARY = "F008"
 </robot>
 ''',
       good=robot('<link name="base"/>'),
-      thresholds="A file that makes no link and no joint, whose top level holds only xacro macro, property, arg and "
-                 "include elements (also inside if/unless) and <material>s, and at least one macro, property or material. "
-                 "The files that include it are looked for in its package (at most 400 files).")
+      thresholds="A library: a file that makes no link and no joint, whose top level holds only xacro macro, property, "
+                 "arg and include elements (also inside if/unless; property and macro also without the xacro: prefix, "
+                 "as xacro before ROS Jade read them) and <material>s, and at least one macro, property or material. A "
+                 "fragment: a xacro file that fails to expand alone and that a file of its package includes. The files "
+                 "that include it are looked for in its package (at most 400 files).")
 def macro_library_file(ctx) -> Iterator[Hit]:
     from ar3cli.urdf.macro_library import macro_library
 
     library = macro_library(ctx.model)
     if library is not None:
-        where = (f"included by {', '.join(library.included_by)}" if library.included_by
-                 else "no file of its package was found to include it")
         yield Hit(f"{library.describe()} and instantiates no robot: a xacro library, checked where an entry file "
-                  f"includes it ({where})", ctx.model.root)
+                  f"includes it ({_includer_text(library.included_by)})", ctx.model.root)
+
+
+def _includer_text(included_by) -> str:
+    return f"included by {', '.join(included_by)}" if included_by else "no file of its package was found to include it"
+
+
+def fragment_message(path, source: bytes, reason: str) -> str | None:
+    """F008's message for a xacro file whose expansion failed with ``reason`` (an F004) when it is a library,
+    or a fragment: it reads a ``$(arg NAME)`` it does not declare (an include body, which reads its includer's
+    arguments: xacro's arguments are global), or a file of its package includes it. Its includer reports the
+    failure (xacro stops there too), so the file itself gets one info line instead of an error. None for an
+    entry file: its F004 stands."""
+    from ar3cli.urdf.macro_library import includers, library_in_source
+
+    library = library_in_source(source, path)
+    if library is not None:
+        return (f"{library.describe()} and instantiates no robot: a xacro library, checked where an entry file "
+                f"includes it ({_includer_text(library.included_by)}); alone it does not expand: {reason}")
+    missing = _UNDEFINED_ARG.search(reason)
+    if missing is not None and missing.group(1) in _undeclared_args(source):
+        return (f"a xacro fragment: it reads $(arg {missing.group(1)}) without declaring it (<xacro:arg>), as an "
+                "include body reads its includer's arguments; it is checked where that file includes it, and does "
+                "not expand alone")
+    found = includers(path)
+    if not found:
+        return None
+    return (f"a xacro fragment included by {', '.join(found)}, where it is checked: alone it does not expand "
+            f"({reason})")
+
+
+_UNDEFINED_ARG = re.compile(r"Undefined substitution argument ([\w.-]+)")
+_ARG_USE = re.compile(rb"\$\(arg\s+([\w.-]+)\s*\)")
+_ARG_DECLARATION = re.compile(rb"<xacro:arg\b[^>]*\bname\s*=\s*[\"']([\w.-]+)[\"']")
+
+
+def _undeclared_args(source: bytes) -> set[str]:
+    """The names the file reads with ``$(arg NAME)`` and never declares with ``<xacro:arg name="NAME">``."""
+    used = {match.group(1).decode("ascii", "replace") for match in _ARG_USE.finditer(source)}
+    declared = {match.group(1).decode("ascii", "replace") for match in _ARG_DECLARATION.finditer(source)}
+    return used - declared

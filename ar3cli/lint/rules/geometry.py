@@ -10,6 +10,7 @@ from pathlib import Path
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.lint.rules.file import SUBSTITUTION
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
+from ar3cli.urdf.model import parse_floats
 
 MAX_PLAUSIBLE_EXTENT = 5.0
 """A robot part larger than this many metres after scaling is almost always a mesh in millimetres."""
@@ -17,6 +18,10 @@ MIN_PLAUSIBLE_EXTENT = 1e-3
 """A part smaller than a millimetre after scaling was probably scaled twice (or is in km)."""
 FLAT_RATIO = 0.01
 """Meshes whose smallest extent is below this fraction of the largest are planes (ground, walls)."""
+SPAN_FACTOR = 3.0
+"""A mesh larger than MAX_PLAUSIBLE_EXTENT is still metres when it is at most this many times the robot's own
+kinematic span (its longest prismatic travel, its furthest joint frame): a gantry lab's 46 m rail for a 37 m
+travel. A millimetre mesh on a metre robot is hundreds of times its span."""
 NON_SPEC_MESH_FORMATS = (".cdf", ".vtk")
 """Mesh extensions PyBullet's URDF importer accepts beyond .stl/.obj/.dae (G010, not G004)."""
 ZERO_THICKNESS = 1e-9
@@ -53,6 +58,9 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
         </link>""")
 
 
+G001_FIX = "Fix the path, or tell ar3cli where the package is with --package-path NAME=DIR."
+
+
 @rule("G001", "mesh-not-found", "error", "Mesh file not found",
       refused_by=("pybullet", "mujoco"),
       breaks='PyBullet refuses the file ("Cannot load URDF file"); RViz and MoveIt draw and collide nothing for '
@@ -60,10 +68,10 @@ def _mesh_robot(filename: str, scale: str = "") -> str:
       why="""PyBullet refuses the whole file with "Cannot load URDF file" (the real reason, the missing
       mesh, only goes to C stdout); RViz shows nothing. ar3cli resolves package:// like ROS
       (--package-path, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, package.xml in ancestors) and relative
-      paths like PyBullet, and lists every place it looked. MuJoCo looks elsewhere: in the
+      paths like PyBullet; the message names the first place it looked and the hint every one. MuJoCo looks elsewhere: in the
       <mujoco><compiler meshdir> of the file, by the mesh's base name; for a robot meant for MuJoCo
       only (--target mujoco) a mesh found there is not reported.""",
-      fix="Fix the path, or tell ar3cli where the package is with --package-path NAME=DIR.",
+      fix=G001_FIX,
       bad=_mesh_robot("meshes/missing.stl"), good=_mesh_robot("meshes/base.stl"),
       references="MuJoCo src/xml/xml_urdf.cc (mesh file names stripped to their base name, looked up in "
                  "<mujoco><compiler meshdir>).")
@@ -72,7 +80,11 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
     for link, _shape, geometry in _meshes(ctx):
         resolution = geometry.resolution
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
-            tried = "; looked in " + resolution.places() if resolution.tried else ""
+            tried, hint = "", None
+            if places := resolution.places():  # the message names the first place, the hint every one (11 on a line)
+                more = len(places) - 1
+                tried = f"; looked in {places[0]}" + (f" and {more} more place{'s' if more > 1 else ''}" if more else "")
+                hint = f"{G001_FIX} Looked in: " + "; ".join(places) + "."
             also = ""
             if meshdir is not None and ctx.model.resolver.is_file(meshdir / _base_name(resolution.uri)):
                 others = [target for target in ctx.targets if target != "mujoco"]
@@ -80,7 +92,7 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
                     continue  # MuJoCo, the only target, finds it through its own meshdir
                 also = f" (only MuJoCo finds it, in its <compiler meshdir> {meshdir})"
             yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{also}{tried}",
-                      geometry.element)
+                      geometry.element, hint=hint)
 
 
 def mujoco_meshdir(model) -> Path | None:
@@ -161,7 +173,8 @@ def lfs_pointer(ctx) -> Iterator[Hit]:
 @rule("G006", "mesh-units", "warning", "Mesh size suggests wrong units",
       why="""URDF meshes are in metres. A mesh exported in millimetres loads silently 1000x too large
       in PyBullet (a 30 cm link becomes 300 m); one scaled twice becomes sub-millimetre. Flat meshes
-      (ground planes, walls) are exempt. A COLLADA file states its own unit (<unit meter="0.0254"/>
+      (ground planes, walls) are exempt, and so is a large mesh on a robot whose own joints span as much
+      (a gantry lab whose rail travels 37 m: its 46 m rail is metres; in millimetres it would be 4.6 cm). A COLLADA file states its own unit (<unit meter="0.0254"/>
       for inches), which PyBullet and assimp (RViz, MoveIt) apply: the size is judged after it. Judged
       against the link itself too: a collision mesh about 1000 times larger or smaller than its own
       visual (a scale="0.001" kept on one and not the other) is in the other unit, whatever its size;
@@ -169,7 +182,9 @@ def lfs_pointer(ctx) -> Iterator[Hit]:
       fix='Add scale="0.001 0.001 0.001" for a millimetre mesh, or re-export it in metres.',
       bad=_mesh_robot("meshes/base_mm.stl"), good=_mesh_robot("meshes/base_mm.stl", "0.001 0.001 0.001"),
       thresholds="Largest extent after scale (and COLLADA unit) above MAX_PLAUSIBLE_EXTENT = 5 m with the smallest "
-                 "above FLAT_RATIO = 0.01 of it, or below MIN_PLAUSIBLE_EXTENT = 1 mm; or a link's collision meshes "
+                 "above FLAT_RATIO = 0.01 of it and the largest above SPAN_FACTOR = 3 times the robot's kinematic span "
+                 "(longest prismatic travel, furthest link frame from the root at the zero pose), or below "
+                 "MIN_PLAUSIBLE_EXTENT = 1 mm; or a link's collision meshes "
                  "SCALE_MISMATCH = 250 to 4000 times larger or smaller than its visual meshes (box diagonals).",
       references="PyBullet LoadMeshFromCollada.cpp (applies <unit meter>); COLLADA 1.4.1 spec, <asset>/<unit>.")
 def mesh_units(ctx) -> Iterator[Hit]:
@@ -206,7 +221,8 @@ def mesh_units(ctx) -> Iterator[Hit]:
         largest, smallest = max(extent), min(extent)
         shown = " x ".join(f"{e:.4g}" for e in extent) + " m after scaling" + (
             f" and the file's COLLADA unit ({unit:g} m)" if unit != 1.0 else "")
-        if largest > MAX_PLAUSIBLE_EXTENT and smallest > FLAT_RATIO * largest:
+        if largest > MAX_PLAUSIBLE_EXTENT and smallest > FLAT_RATIO * largest \
+                and largest > SPAN_FACTOR * ctx.kinematic_span():
             yield Hit(f"link '{link.name}' mesh {geometry.filename} is {shown}: millimetres?",
                       geometry.element)
         elif 0 < largest < MIN_PLAUSIBLE_EXTENT:
@@ -320,6 +336,16 @@ marker (a sensor frame drawn as a 1 cm cube, pr2's and Talos' IMU boxes), not a 
 MARKER_MASS = 1e-4
 """A link lighter than this fraction of the whole robot (or of mass 0) is a frame with a picture (Baxter's
 0.1 g display and camera links, a "nocol" marker sphere), not a body."""
+FRAME_DRAWING = 0.5
+"""A link with no <inertial>, welded to its parent and drawn with primitives (no mesh) smaller than this
+fraction of its parent is a frame drawn for people (Fourier's 5 mm fingertip spheres, a TCP ball), not a part."""
+ENCLOSED = 0.9
+"""A part whose drawing lies at least this much (by volume of its box) inside its neighbours' collision shapes at
+the zero pose needs no collision of its own: nothing reaches it without touching them first."""
+NEIGHBOUR_DEPTH = 2
+"""Joints away from a part that its neighbours may be (parent, grandparent, children, grandchildren, siblings)."""
+_GRID = 4
+"""Sample points per axis of a part's box when its enclosure is measured (4 x 4 x 4 cell centres)."""
 
 
 @rule("G008", "no-collision", "warning", "Link with visual but no collision geometry",
@@ -327,18 +353,26 @@ MARKER_MASS = 1e-4
       (no contacts, no self-collision checks), and PyBullet's default inertia comes from the
       collision shape, so it falls back to a tiny default box. Visuals meant to be passed through are
       not reported: a zero-size placeholder (<box size="0 0 0"/>), and markers, judged against the
-      robot itself: a link drawn much smaller than its other links, or one that weighs next to
-      nothing against the whole robot.""",
+      robot itself: a link drawn much smaller than its other links, one that weighs next to nothing
+      against the whole robot, or a frame drawn for people (no <inertial>, welded to its parent, drawn
+      as spheres, or as primitives much smaller than the parent: a fingertip or TCP marker). Nor is a part whose
+      drawing lies inside its neighbours' collision shapes at the zero pose (a wrist cross between
+      two covered links, a cover inside the chassis' collision mesh, a caster inside a base's
+      collision spheres): nothing reaches it without touching them first.""",
       fix="Add a <collision> (a primitive or a simplified mesh).",
       bad=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual></link>'),
       good=robot(f'<link name="base">{LINK_INERTIAL}<visual><geometry><box size="1 1 1"/></geometry></visual>'
                  '<collision><geometry><box size="1 1 1"/></geometry></collision></link>'),
       thresholds=f"Not reported: every visual of zero volume; visuals whose box diagonal is below MARKER_SIZE = "
                  f"{MARKER_SIZE:g} of the robot's median link size; a link whose mass is at most MARKER_MASS = "
-                 f"{MARKER_MASS:g} of the robot's.")
+                 f"{MARKER_MASS:g} of the robot's; a link without <inertial> on a fixed joint drawn with spheres, or with "
+                 f"primitives smaller than FRAME_DRAWING = {FRAME_DRAWING:g} of its parent; a link whose visual box lies at least "
+                 f"ENCLOSED = {ENCLOSED:g} inside the collision shapes of the links up to NEIGHBOUR_DEPTH = "
+                 f"{NEIGHBOUR_DEPTH} joints away at the zero pose.")
 def no_collision(ctx) -> Iterator[Hit]:
     for link in ctx.model.links:
-        if link.visuals and not link.collisions and not _pass_through_visual(ctx, link):
+        if link.visuals and not link.collisions and not _pass_through_visual(ctx, link) \
+                and not _enclosed(ctx, link):
             yield Hit(f"link '{link.name}' has {len(link.visuals)} visual shape(s) but no <collision>", link.element)
 
 
@@ -351,7 +385,62 @@ def _pass_through_visual(ctx, link) -> bool:
     if mass is not None and math.isfinite(mass) and 0 <= mass <= MARKER_MASS * ctx.total_mass():
         return True
     size, scale = ctx.link_size(link), ctx.robot_scale()
-    return size is not None and scale is not None and size < MARKER_SIZE * scale
+    if size is not None and scale is not None and size < MARKER_SIZE * scale:
+        return True
+    return _drawn_frame(ctx, link, size)
+
+
+def _drawn_frame(ctx, link, size: float | None) -> bool:
+    """A frame drawn for people: no <inertial> (the author gave it no body), welded to its parent, drawn with
+    spheres (a ball marks a point), or with primitives smaller than FRAME_DRAWING of its parent."""
+    joint = ctx.model.parent_joint(link.name)
+    if link.inertial is not None or joint is None or joint.type != "fixed" or size is None \
+            or any(shape.geometry.kind == "mesh" for shape in link.visuals):
+        return False
+    if all(shape.geometry.kind == "sphere" for shape in link.visuals):
+        return True  # a ball marks a point: a TCP, a fingertip
+    parent = ctx.model.link(joint.parent) if joint.parent else None
+    parent_size = ctx.link_size(parent) if parent is not None else None
+    return parent_size is not None and size < FRAME_DRAWING * parent_size
+
+
+def _neighbours(model, link, depth: int = NEIGHBOUR_DEPTH):
+    """The links up to ``depth`` joints from ``link`` (parent, children, and theirs), ``link`` left out."""
+    found, frontier = {link.name}, [link.name]
+    for _ in range(depth):
+        reached = []
+        for name in frontier:
+            joint = model.parent_joint(name)
+            around = [joint.parent] if joint is not None and joint.parent else []
+            around += [child.child for child in model.child_joints(name) if child.child]
+            reached += [other for other in around if other not in found]
+            found.update(around)
+        frontier = reached
+    found.discard(link.name)
+    return [other for name in found if (other := model.link(name)) is not None]
+
+
+def _enclosed(ctx, link) -> bool:
+    """True when at least ENCLOSED of the link's (visual) box lies inside the collision shapes of its
+    :func:`_neighbours` at the zero pose, sampled at _GRID³ cell centres."""
+    own = ctx.zero_pose_box(link.name, ctx.link_bounds(link))
+    if own is None:
+        return False
+    covers = [box for other in _neighbours(ctx.model, link) for shape in other.collisions
+              if (box := ctx.zero_pose_box(other.name, ctx.shape_bounds(shape))) is not None]
+    if not covers:
+        return False
+    steps = [(i + 0.5) / _GRID for i in range(_GRID)]
+    (x0, y0, z0), (x1, y1, z1) = own
+    inside = 0
+    for fx in steps:
+        x = x0 + fx * (x1 - x0)
+        for fy in steps:
+            y = y0 + fy * (y1 - y0)
+            for fz in steps:
+                z = z0 + fz * (z1 - z0)
+                inside += any(lo[0] <= x <= hi[0] and lo[1] <= y <= hi[1] and lo[2] <= z <= hi[2] for lo, hi in covers)
+    return inside >= ENCLOSED * _GRID ** 3
 
 
 @rule("G009", "pybullet-only-path", "info", "Mesh found only by PyBullet's fallback search",
@@ -540,6 +629,38 @@ def mesh_flat(ctx) -> Iterator[Hit]:
         if flat:
             yield Hit(f"link '{link.name}' collision mesh {shape.geometry.filename} is flat (no volume): MuJoCo 3.3+ "
                       "refuses it as a collision shape", shape.geometry.element)
+
+
+ZERO_SIZE_KEYS = {"box": ("size",), "sphere": ("radius",), "cylinder": ("radius", "length"),
+                  "capsule": ("radius", "length")}
+"""The size attributes of each primitive (G018)."""
+
+
+@rule("G018", "zero-size-collision", "error", "Collision primitive of zero size",
+      engines=("mujoco",), refused_by=("mujoco",),
+      breaks='MuJoCo refuses the file ("size 0 must be positive in geom"; measured with MuJoCo 4.0).',
+      why="""A <collision> box, sphere, cylinder or capsule with a size of 0 (<sphere radius="0.00"/>, a
+      placeholder left by an exporter) collides as nothing in PyBullet, which loads it, and stops
+      MuJoCo's whole compile ("size 0 must be positive in geom", measured with MuJoCo 4.0 on ARMAR-4's
+      legs and eyes). A zero-size <visual> is a placeholder every engine draws as nothing (G008 leaves it
+      alone). Negative sizes are the same mistake.""",
+      fix="Give the collision shape its real size, or remove the <collision>.",
+      bad=robot(f'<link name="base">{LINK_INERTIAL}<collision><geometry><sphere radius="0.00"/></geometry></collision></link>'),
+      good=robot(f'<link name="base">{LINK_INERTIAL}<collision><geometry><sphere radius="0.02"/></geometry></collision></link>'),
+      references="MuJoCo src/user/user_objects.cc (mjsGeom sizes must be positive); measured with MuJoCo 4.0.")
+def zero_size_collision(ctx) -> Iterator[Hit]:
+    for link in ctx.model.links:
+        for shape in link.collisions:
+            element = shape.geometry.element
+            keys = ZERO_SIZE_KEYS.get(shape.geometry.kind)
+            if element is None or keys is None:
+                continue
+            values = [value for key in keys for value in (parse_floats(element.get(key)) or ())]
+            if any(math.isfinite(value) and value <= 0 for value in values):  # non-finite and malformed: F007's
+                written = " ".join(f'{key}="{element.get(key)}"' for key in keys if element.get(key) is not None)
+                yield Hit(f"link '{link.name}' collision <{shape.geometry.kind} {written}/> has no size: MuJoCo "
+                          "refuses the file (size 0 must be positive in geom), PyBullet collides nothing there",
+                          element)
 
 
 @rule("G013", "hull-much-larger", "info", "Collision mesh much smaller than its convex hull",

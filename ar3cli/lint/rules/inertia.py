@@ -82,30 +82,103 @@ def _fmt(moments) -> str:
                  "'world'); docs/pybullet-facts.md.")
 def inertial_missing(ctx) -> Iterator[Hit]:
     moving = _moving_links(ctx.model)
+    phantom_only = not set(ctx.targets) & REFUSE_MASSLESS
     for link in ctx.model.links:
         if link.inertial is None and link.name in moving:
+            if phantom_only and translating_frame(ctx, link) is not None:
+                continue  # PyBullet's 1 kg on a frame that only translates, carrying far more: I017's, an info
             yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') but has no <inertial>: "
                       "PyBullet uses 1 kg and I = 1", link.element)
+
+
+PHANTOM_SHARE = 0.02
+"""PyBullet's 1 kg on a frame that only translates is at most this share of the mass it carries (I017)."""
+REFUSE_MASSLESS = frozenset({"mujoco", "drake", "gazebo"})
+"""Targets for which a moving link without <inertial> is an error whatever it carries: MuJoCo refuses a moving
+body without mass (below mjMINVAL), Drake's is singular, Gazebo drops the link."""
+
+
+def translating_frame(ctx, link) -> float | None:
+    """The mass (kg, from the file) that ``link``'s prismatic joint moves, when ``link`` is a frame of a virtual
+    planar base: no <inertial> and no geometry, every joint from a geometry-less root down to it prismatic (or
+    fixed), so it never rotates and its I = 1 plays no part; and PyBullet's 1 kg is at most PHANTOM_SHARE of what
+    it carries. None otherwise."""
+    from ar3cli.lint.rules.plausibility import subtree_masses
+
+    if link.inertial is not None or link.has_geometry:
+        return None
+    above = list(ctx.model.joints_above(link.name))
+    if not above or above[0].type != "prismatic" or any(j.type not in ("prismatic", "fixed") for j in above):
+        return None
+    root = ctx.model.link(above[-1].parent) if above[-1].parent else None
+    if root is None or root.has_geometry or ctx.model.parent_joint(root.name) is not None:
+        return None
+    carried = ctx.shared("subtree-masses", subtree_masses)[link.name]
+    return carried if carried > 0 and PHANTOM_SHARE * carried >= 1.0 else None
+
+
+@rule("I017", "translating-frame-inertial-missing", "info", "A planar base's virtual link without <inertial>",
+      engines=("pybullet",),
+      why="""A mobile base moved in the plane is often written as a chain of virtual links: x and y prismatic
+      joints from a fixed root, then the yaw joint to the chassis (Clearpath's Ridgeback). Its x/y links have
+      no <inertial>: PyBullet gives each 1 kg and I = 1, but they never rotate, so the inertia plays no part,
+      and a kilogram on a base of a hundred moves it barely differently (measured with pybullet 3.2.7 on a
+      165 kg base with two such links: 1.2% less travel under the same force, yaw unchanged). I001 reports
+      such a link when the 1 kg is a larger share of what it carries, or when --target names MuJoCo, Drake
+      or Gazebo (MuJoCo refuses a moving body without mass).""",
+      fix="Give the virtual links a tiny <inertial> (mass 1e-6 kg, I = 1e-12), or leave them.",
+      bad=robot("""
+          <link name="odom"/><link name="x_link"/>
+          <link name="chassis"><inertial><mass value="165"/><inertia ixx="4" ixy="0" ixz="0" iyy="8" iyz="0" izz="10"/></inertial></link>
+          <joint name="x" type="prismatic"><parent link="odom"/><child link="x_link"/><axis xyz="1 0 0"/>
+            <limit lower="-100" upper="100" effort="100" velocity="1"/></joint>
+          <joint name="yaw" type="continuous"><parent link="x_link"/><child link="chassis"/><axis xyz="0 0 1"/></joint>"""),
+      good=robot("""
+          <link name="odom"/>
+          <link name="x_link"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
+          <link name="chassis"><inertial><mass value="165"/><inertia ixx="4" ixy="0" ixz="0" iyy="8" iyz="0" izz="10"/></inertial></link>
+          <joint name="x" type="prismatic"><parent link="odom"/><child link="x_link"/><axis xyz="1 0 0"/>
+            <limit lower="-100" upper="100" effort="100" velocity="1"/></joint>
+          <joint name="yaw" type="continuous"><parent link="x_link"/><child link="chassis"/><axis xyz="0 0 1"/></joint>"""),
+      thresholds="A link without <inertial> and geometry whose parent joint is prismatic, every joint above it "
+                 "prismatic or fixed from a root without geometry, carrying at least 1 kg / PHANTOM_SHARE = 50 kg; "
+                 "only when --target names none of MuJoCo, Drake, Gazebo (else I001).")
+def translating_frame_inertial_missing(ctx) -> Iterator[Hit]:
+    if set(ctx.targets) & REFUSE_MASSLESS:
+        return
+    for link in ctx.model.links:
+        carried = translating_frame(ctx, link)
+        if carried is not None:
+            joint = ctx.model.parent_joint(link.name)
+            yield Hit(f"link '{link.name}' (prismatic joint '{joint.name}') has no <inertial>: PyBullet gives it 1 kg, "
+                      f"{100 / carried:.1g}% of the {carried:g} kg it carries, and I = 1, which plays no part: it never "
+                      "rotates", link.element)
 
 
 @rule("I002", "fixed-link-inertial-missing", "warning", "Link on a fixed joint without <inertial>",
       engines=("pybullet",),
       why="""A frame link (tool tip, sensor frame) hangs from a fixed joint and often has neither
       geometry nor <inertial>. PyBullet still gives it 1 kg and I = 1, so every tcp/camera frame adds
-      a kilogram to the arm's end.""",
+      a kilogram to the arm's end. A link welded to the root (the base's frames, a mounting plate's
+      markers) belongs to the base: its kilogram matters only if the robot floats, which I012 says, once
+      for the base, at info.""",
       fix="Add a tiny <inertial> (mass 1e-6 kg, I = 1e-12: measured to act like mass 0 within 3e-6 N·m) or run ar3cli fix-inertia.",
       bad=robot(f"""
-          <link name="base">{LINK_INERTIAL}</link><link name="tcp"/>
-          <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""),
+          <link name="base">{LINK_INERTIAL}</link><link name="arm">{LINK_INERTIAL}</link><link name="tcp"/>
+          <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <joint name="tcp_joint" type="fixed"><parent link="arm"/><child link="tcp"/></joint>"""),
       good=robot(f"""
-          <link name="base">{LINK_INERTIAL}</link>
+          <link name="base">{LINK_INERTIAL}</link><link name="arm">{LINK_INERTIAL}</link>
           <link name="tcp"><inertial><mass value="1e-6"/><inertia ixx="1e-12" ixy="0" ixz="0" iyy="1e-12" iyz="0" izz="1e-12"/></inertial></link>
-          <joint name="tcp_joint" type="fixed"><parent link="base"/><child link="tcp"/></joint>"""),
+          <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+            <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>
+          <joint name="tcp_joint" type="fixed"><parent link="arm"/><child link="tcp"/></joint>"""),
       fixed_by="fix-inertia")
 def fixed_link_inertial_missing(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         link = ctx.model.link(joint.child) if joint.type == "fixed" and joint.child else None
-        if link is None or link.inertial is not None or link.name == "world":
+        if link is None or link.inertial is not None or link.name == "world" or _welded_to_root(ctx, link):
             continue
         kind = "has geometry" if link.has_geometry else FRAME_LINK_PHRASE
         yield Hit(f"link '{link.name}' {kind} on fixed joint '{joint.name}' without <inertial>: "
@@ -333,7 +406,9 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
       its COM it cannot exceed the diagonal of its bounding box). A much larger value means the
       tensor belongs to something else: a placeholder I = 1 on a 0.1 kg link, grams vs kilograms, or
       g·mm² vs kg·m². The link then swings like a body many metres wide. A tensor no body can have
-      (I004, I005, I009) is reported there alone. When the tensor read in kg·mm² or g·mm² (a CAD
+      (I004, I005, I009) is reported there alone. The body's size is the box around all its shapes,
+      visual and collision: a part that collides as a placeholder (Baxter's screen, a 1 mm sphere) is
+      still as large as it is drawn. When the tensor read in kg·mm² or g·mm² (a CAD
       export's units) gives the robot's typical radius of gyration, the message says so, with the
       value in kg·m².""",
       fix="Recompute the tensor from the geometry and the mass (ar3cli fix-inertia).",
@@ -341,8 +416,8 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
                          '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>'),
       good=arm(link_extra=LINK_INERTIAL + '<collision><geometry><box size="0.3 0.3 0.3"/></geometry></collision>'),
       fixed_by="fix-inertia --include-implausible",
-      thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the link's "
-                 "geometry box (collision shapes, else visual). A unit is named when the tensor / 1e6 (kg·mm²) or / 1e9 "
+      thresholds="Radius of gyration sqrt(I_max / m) above IMPLAUSIBLE_FACTOR = 3 half-diagonals of the box around the "
+                 "link's visual and collision shapes. A unit is named when the tensor / 1e6 (kg·mm²) or / 1e9 "
                  "(g·mm²) gives a ratio within SAME_SHAPE = 5x of the robot's median link ratio and an I_max within "
                  "SOLID_RANGE = 0.05 to 4 times a solid box the size of the geometry; never for a placeholder (a "
                  "diagonal of powers of ten).")
@@ -378,7 +453,7 @@ def _gyration(ctx, link, mass: float | None) -> tuple[float, float, float, float
     if inertial is None or not finite_tensor(inertial.tensor) or mass is None or not mass > 0 \
             or not math.isfinite(mass):
         return None
-    bounds = ctx.link_bounds(link)
+    bounds = ctx.body_bounds(link)
     if bounds is None:
         return None
     half_diagonal = 0.5 * math.dist(bounds[0], bounds[1])
@@ -431,7 +506,7 @@ def tensor_unit(ctx, link) -> tuple[str, float] | None:
     if found is None or found[0] <= IMPLAUSIBLE_FACTOR or _placeholder_tensor(link.inertial.tensor):
         return None
     mass = mass or link.inertial.mass
-    box = ctx.link_bounds(link)
+    box = ctx.body_bounds(link)
     extents = sorted(hi - lo for lo, hi in zip(*box))
     solid = mass * (extents[1] ** 2 + extents[2] ** 2) / 12  # I_max of a solid box the size of the geometry
     typical = typical_gyration(ctx)
@@ -497,6 +572,12 @@ def world_inertial(ctx) -> Iterator[Hit]:
                       link.inertial.element)
 
 
+def _welded_to_root(ctx, link) -> bool:
+    """Whether ``link`` is welded (fixed joints only) to a root link: part of the base, static when the robot is
+    loaded with a fixed base, so its phantom kilogram matters only if the robot floats (I012's, at info)."""
+    return ctx.model.parent_joint(ctx.rigid_body(link).top) is None
+
+
 @rule("I012", "root-inertial-missing", "info", "Root link with geometry but no <inertial>",
       engines=("pybullet", "drake"),
       why="""This matters only if the robot floats (a mobile base, a legged robot, an object to
@@ -506,13 +587,16 @@ def world_inertial(ctx) -> Iterator[Hit]:
       singular. (MuJoCo's URDF import fixes the root to the world whatever its mass.)
       A root without geometry weighs 1 kg in PyBullet too (only one named world gets 0): a frame fixed
       on top of a body (base_footprint, Jackal's base_link over its chassis) is reported, as the body
-      under it is most likely a mobile base; a frame an arm turns on (a moving joint) is not.""",
+      under it is most likely a mobile base; a frame an arm turns on (a moving joint) is not. Links welded to the root by fixed joints belong to the same body: those
+      without <inertial> add PyBullet's 1 kg each to it when it floats, and nothing when it is fixed, so
+      they are listed here (one finding for the base) rather than as I002 warnings.""",
       fix="If the robot floats, give the root link its real <inertial> (ar3cli fix-inertia --links ROOT computes one "
-          "from the geometry); if it is always fixed to the world, nothing to do.",
+          "from the geometry) and the frames welded to it a tiny one; if it is always fixed to the world, nothing to "
+          "do.",
       bad=robot('''<link name="chassis"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
       good=robot(f'''<link name="chassis">{LINK_INERTIAL}<collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>'''),
-      thresholds="Skipped: a root named world (PyBullet gives it no mass), and a root without geometry that "
-                 "is not joined to the rest by fixed joints only (an arm's mounting frame).",
+      thresholds="Skipped: a root named world (PyBullet gives it no mass; nor its welded links), and a root without "
+                 "geometry that is not joined to the rest by fixed joints only (an arm's mounting frame).",
       references="PyBullet UrdfParser.cpp parseLink (mass 1, inertia 1 without <inertial>); Drake "
                  "multibody/parsing/detail_urdf_parser.cc ParseBody (no <inertial>: zero spatial inertia).")
 def root_inertial_missing(ctx) -> Iterator[Hit]:
@@ -520,15 +604,31 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
     if len(roots) != 1:
         return  # no root or several: S005's business
     root = roots[0]
+    if root.name == "world":
+        return  # PyBullet's only mass-0 default: a static base, with whatever is welded to it
+    welded = [name for name in ctx.rigid_body(root).members if name not in (root.name, "world")
+              and ctx.model.link(name).inertial is None]
+    shown = ", ".join(f"'{name}'" for name in welded[:3]) + (", ..." if len(welded) > 3 else "")
+    also = (f", nor {'do' if len(welded) > 1 else 'does'} the {len(welded)} link{'s' if len(welded) > 1 else ''} "
+            f"welded to it ({shown})" if welded else "")
+    gets = f"PyBullet gives {'each' if welded else 'it'} 1 kg and I = 1, Drake no mass at all"
     below = [joint.type for joint in ctx.model.joints if joint.parent == root.name]
-    frame_on_a_body = bool(below) and all(kind == "fixed" for kind in below)
-    if root.inertial is None and root.name != "world" and (root.has_geometry or frame_on_a_body):
-        what = "has geometry but" if root.has_geometry else "is a frame (no geometry) with"
-        fix = (f"ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write the real <inertial>)"
-               if root.has_geometry else "give it a tiny <inertial> (mass 1e-6 kg, I = 1e-12)")
-        yield Hit(f"root link '{root.name}' {what} no <inertial>: if this robot floats, PyBullet gives it "
-                  "1 kg and I = 1, Drake no mass at all", root.element,
-                  hint=f"If the robot floats: {fix}; a fixed-base arm can ignore this.")
+    if root.inertial is None and root.has_geometry:
+        yield Hit(f"root link '{root.name}' has geometry but no <inertial>{also}: if this robot floats, {gets}",
+                  root.element,
+                  hint=f"If the robot floats: ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write "
+                       "the real <inertial>); a fixed-base arm can ignore this.")
+    elif root.inertial is None and below and all(kind == "fixed" for kind in below):
+        yield Hit(f"root link '{root.name}' is a frame (no geometry) with no <inertial>{also}, on top of a body: "
+                  f"if this robot floats, {gets}", root.element,
+                  hint="If the robot floats: give it a tiny <inertial> (mass 1e-6 kg, I = 1e-12) or run ar3cli "
+                       "fix-inertia; a fixed-base robot can ignore this.")
+    elif welded:
+        yield Hit(f"{len(welded)} link{'s' if len(welded) > 1 else ''} welded to root link '{root.name}' "
+                  f"{'have' if len(welded) > 1 else 'has'} no <inertial> ({shown}): if this robot floats, PyBullet adds "
+                  "1 kg and I = 1 for each to its base", root.element,
+                  hint="If the robot floats: give each a tiny <inertial> (mass 1e-6 kg, I = 1e-12) or run ar3cli "
+                       "fix-inertia; a fixed-base robot can ignore this.")
 
 
 FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,
@@ -538,7 +638,8 @@ in its order of reasons: I007 last, so a link reported as I007 has nothing inval
 RESCALED_BY_FIX_INERTIA = (density_implausible,)
 """Rules fix-inertia answers by rescaling the file's own numbers where their unit is plain (a mass in grams,
 I013; I007's tensors in kg·mm² or g·mm² too): :func:`unit_mistakes`."""
-NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing)
+NOT_FIXED_BY_FIX_INERTIA = (mass_zero_with_inertia, world_inertial, root_inertial_missing,
+                            translating_frame_inertial_missing)
 """Inertia findings fix-inertia leaves alone: the fix is a decision only the author can make."""
 
 

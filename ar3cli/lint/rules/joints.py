@@ -44,20 +44,52 @@ def limit_missing(ctx) -> Iterator[Hit]:
 
 @rule("J002", "limit-range-missing", "error", "<limit> without lower/upper on a revolute or prismatic joint",
       engines=("ros", "pybullet"),
-      breaks="ROS tools lock the joint at 0 while PyBullet leaves it unlimited: one file, two different robots.",
-      why="""Without lower/upper, urdfdom and ROS default both to 0 (the joint cannot move), while
-      PyBullet reads (0, -1), i.e. unlimited: the same file means a locked joint in one tool and a
-      free one in the other.""",
+      breaks="ROS tools lock the joint at 0 while PyBullet leaves it unlimited, or holds it in a range that "
+             "excludes 0 (measured): one file, two different robots.",
+      why="""The URDF spec defaults a missing lower or upper to 0, and urdfdom (ROS, MoveIt), MuJoCo and
+      PyBullet's lower follow it; PyBullet's missing upper is -1 instead (measured with pybullet 3.2.7,
+      getJointInfo and torque-driven motion). So what the joint becomes depends on which bound is missing.
+      Neither: urdfdom reads 0..0 (the joint cannot move), PyBullet (0, -1), i.e. unlimited. Only lower:
+      urdfdom reads lower..0; PyBullet reads lower..-1, which is unlimited when lower > -1 and otherwise a
+      range that excludes 0 (the home pose is outside it, and a position target of 0 is driven to -1).
+      Only upper: every tool reads 0..upper, the spec's meaning, which is not reported; an upper below 0
+      puts the default lower above it (PyBullet: unlimited, urdfdom: an empty range).""",
       fix="Give lower and upper explicitly, or make the joint continuous if it really has no stops.",
-      bad=arm(joint_extra='<limit effort="10" velocity="1"/>'), good=arm())
+      bad=arm(joint_extra='<limit effort="10" velocity="1"/>'),
+      good=arm(joint_extra='<limit upper="0.04" effort="10" velocity="1"/>'),
+      references="URDF spec (wiki.ros.org/urdf/XML/joint: lower and upper default to 0); PyBullet UrdfParser.cpp "
+                 "parseJointLimits (upper defaults to -1); measured with pybullet 3.2.7 and MuJoCo 4.0.")
 def limit_range_missing(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         limit = joint.limit
         if joint.type in LIMITED_TYPES and limit is not None:
-            missing = [key for key in ("lower", "upper") if limit.element.get(key) is None]
-            if missing:
-                yield Hit(f"{joint.type} joint '{joint.name}' <limit> has no {' or '.join(missing)} "
-                          "(PyBullet: unlimited; ROS: 0)", limit.element)
+            message = _one_sided_limit(joint)
+            if message is not None:
+                yield Hit(f"{joint.type} joint '{joint.name}' <limit> {message}", limit.element)
+
+
+def _one_sided_limit(joint) -> str | None:
+    """What each tool makes of a <limit> missing a bound (J002), or None when they all agree."""
+    limit = joint.limit
+    has_lower, has_upper = limit.element.get("lower") is not None, limit.element.get("upper") is not None
+    if has_lower and has_upper:
+        return None
+    if not has_lower and not has_upper:
+        return "has no lower or upper: PyBullet reads (0, -1), i.e. unlimited; urdfdom and MuJoCo read 0..0, a locked joint"
+    if has_upper:
+        upper = limit.upper
+        if upper is None or not math.isfinite(upper) or upper >= 0:
+            return None  # every tool reads 0..upper (a malformed number is F007's)
+        return (f"has upper {upper:g} and no lower: the default lower 0 is above it, so PyBullet leaves the joint "
+                "unlimited and urdfdom reads an empty range")
+    lower = limit.lower
+    if lower is None or not math.isfinite(lower):
+        return None
+    ros = f"urdfdom and MuJoCo read {lower:g}..0" if lower <= 0 else f"urdfdom reads an empty range {lower:g}..0"
+    if lower > -1:
+        return f"has lower {lower:g} and no upper: PyBullet reads upper -1, below lower, i.e. unlimited; {ros}"
+    return (f"has lower {lower:g} and no upper: PyBullet reads upper -1, so its range {lower:g}..-1 excludes 0 "
+            f"(a position target of 0 is driven to -1); {ros}")
 
 
 @rule("J003", "limit-inverted", "error", "Joint lower limit greater than upper",

@@ -14,8 +14,17 @@ from collections.abc import Iterator
 from typing import Any
 
 from ar3cli.errors import UserError
-from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
-from ar3cli.lint.rules.pybullet_sim import depth_text, unstable_hit
+from ar3cli.lint.rules.base import (
+    LINK_INERTIAL,
+    Hit,
+    arm,
+    elements_reported,
+    error_explained,
+    refusal_explained,
+    robot,
+    rule,
+)
+from ar3cli.lint.rules.pybullet_sim import built_touching, depth_text, srdf_hint, unstable_hit
 
 SETTLE_SECONDS = 1.0
 MAX_SETTLE_SPEED = 100.0
@@ -23,6 +32,9 @@ MAX_SETTLE_SPEED = 100.0
 PENETRATION = 1e-6
 """m: as P002 (``sim.session.PENETRATION_TOLERANCE``), contacts shallower than this are resting faces."""
 _COMPILED = "_ar3cli_mujoco"
+STATIC_MESH_RULES = ("G001", "G004", "G011", "F006")
+"""Static rules that already report a collision mesh MuJoCo cannot read (missing, unexpanded, a format or bytes
+no engine reads): M002 does not say it again."""
 
 
 def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
@@ -38,21 +50,30 @@ def _compiled(ctx: Any) -> tuple[Any, UserError | None]:
 
 
 
+TOO_LIGHT = ('<inertial><mass value="1e-16"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/>'
+             '</inertial>')
+"""M001's example: a mass below mjMINVAL, which no static rule calls an error (I014 warns that it is light)."""
+
+
 @rule("M001", "mujoco-compile-failed", "error", "MuJoCo refuses to compile the model",
       engines=("mujoco",), refused_by=("mujoco",), breaks="MuJoCo refuses the file (measured: ar3cli compiles it).",
       why="""Most robot learning now trains in MuJoCo (and MJX, MuJoCo Warp). Its compiler is stricter than
       PyBullet's loader: a moving body whose mass or inertia is below mjMINVAL (a link without <inertial>
       and without collision geometry), an inertia breaking A + B >= C, a zero joint axis. ar3cli quotes
       MuJoCo's reason at the link or joint it names; when a static error that MuJoCo refuses (I005,
-      I006, J009, ...) already names the cause at its line, M001 adds nothing.""",
+      I006, J009, ...) already names the cause at its line, or a static error is about the very link
+      MuJoCo names (I001 on a link without <inertial>, S019 on an <inertial> without <inertia>), M001 adds
+      nothing.""",
       fix="Fix the reason quoted in the message (often an I or J finding of the same element).",
-      bad=arm(link_extra=""), good=arm(), needs_sim=True,
+      bad=arm(link_extra=TOO_LIGHT), good=arm(), needs_sim=True,
       references="MuJoCo 4.0 user_objects.cc: 'mass and inertia of moving bodies must be larger than mjMINVAL'")
 def mujoco_compile_failed(ctx) -> Iterator[Hit]:
     from ar3cli.sim.mujoco_session import MujocoCompileError
 
     robot, error = _compiled(ctx)
     if error is not None and refusal_explained(ctx, "mujoco") is None:  # else a static error says why
+        if isinstance(error, MujocoCompileError) and error_explained(ctx, error.element) is not None:
+            return  # the link MuJoCo names is a static error's already (I001, S019: the same cause)
         if isinstance(error, MujocoCompileError):
             yield Hit(f"MuJoCo cannot compile it: {error.reason}",
                       error.element if error.element is not None else ctx.model.root)
@@ -70,16 +91,25 @@ _STL = robot(f"""
       engines=("mujoco",),
       why="""MuJoCo reads STL, OBJ and MSH meshes only: a COLLADA (.dae) collision mesh, or one that is not found,
       stops its whole compile with "Error opening file". ar3cli replaces the mesh by its bounding box (or leaves
-      it out when its size is unknown) so the other checks still run, and says so here.""",
+      it out when its size is unknown) so the other checks still run, and says so here, for the meshes no
+      static rule reports already (G001 a missing mesh, F006 an unexpanded path, G004 a format, G011 bytes
+      no engine reads): in practice a COLLADA collision mesh, which PyBullet reads.""",
       fix="Export the collision mesh as STL or OBJ (keep the .dae for visuals, which MuJoCo discards).",
       bad=_DAE, good=_STL, needs_sim=True)
 def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
     robot, error = _compiled(ctx)
     if robot is None:
         return
+    known = elements_reported(ctx, STATIC_MESH_RULES)
     for substitution in robot.substitutions:
+        if substitution.element in known:
+            continue  # a missing, unexpanded, unreadable or unloadable mesh: the static rule says so at it
         yield Hit(f"link '{substitution.link}': {substitution.reason}; {substitution.replacement} for MuJoCo",
                   substitution.element)
+
+
+M003_FIX = ("Fix the collision geometry or the joint origin; if the overlap is by design, exclude the pair "
+            "(<contact><exclude> in MJCF, or an SRDF for MoveIt).")
 
 
 @rule("M003", "mujoco-self-collision-home", "warning", "Links collide in MuJoCo at the home pose",
@@ -87,9 +117,12 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
       why="""MuJoCo collides every pair of bodies but a parent and its child (no URDF_USE_SELF_COLLISION flag
       to forget): two links interpenetrating at the home pose are pushed apart the moment the simulation
       starts, which puts energy into a robot at rest. Pairs adjacent in MoveIt's sense or joined only by
-      fixed joints are not reported, as for P002.""",
-      fix="Fix the collision geometry or the joint origin; if the overlap is by design, exclude the pair "
-          "(<contact><exclude> in MJCF, or an SRDF for MoveIt).",
+      fixed joints are not reported, as for P002, nor the pairs an SRDF disables (--srdf, else the
+      package's own SRDF for this robot), nor the contacts a robot is built with (a joint cluster, one
+      linkage, two branches touching by at most 3 mm, a placeholder collision: P002 explains each). Nor is a pair where a link collides through a box ar3cli
+      put in place of a mesh MuJoCo cannot read (M002: a COLLADA collision mesh): boxes around concave
+      parts overlap where the parts do not, so such a contact says nothing about the robot.""",
+      fix=M003_FIX,
       bad=robot("""
         <link name="base"><inertial><mass value="1"/><inertia ixx="0.01" ixy="0" ixz="0" iyy="0.01" iyz="0" izz="0.01"/></inertial>
           <collision><geometry><box size="0.2 0.2 0.2"/></geometry></collision></link>
@@ -102,7 +135,7 @@ def mujoco_mesh_unreadable(ctx) -> Iterator[Hit]:
         <joint name="j2" type="revolute"><parent link="mid"/><child link="tip"/><origin xyz="0 0 -0.25"/>
           <axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/></joint>"""),
       good=arm(), needs_sim=True,
-      thresholds="Deeper than PENETRATION = 1e-6 m, as P002.")
+      thresholds="Deeper than PENETRATION = 1e-6 m; the contacts a robot is built with as for P002.")
 def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import adjacent_pairs, rigid_groups
     from ar3cli.sim.mujoco_session import home_pose
@@ -114,13 +147,19 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     robot.set_positions(home_pose(ctx.model))
     adjacent = adjacent_pairs(ctx.model)
     group = rigid_groups(ctx.model, robot.joint_ids)
+    stand_ins = {substitution.link for substitution in robot.substitutions}
+    disabled, note = ctx.disabled_pairs()
     for a, b, depth in robot.contacts(PENETRATION):
-        if frozenset((a, b)) in adjacent or is_disabled(ctx.srdf_disabled, a, b) or \
+        if frozenset((a, b)) in adjacent or is_disabled(disabled, a, b) or \
                 (a in group and group[a] == group.get(b)):
+            continue
+        if a in stand_ins or b in stand_ins:
+            continue  # a box ar3cli put in place of a mesh MuJoCo cannot read (M002): not the robot's shape
+        if built_touching(ctx, a, b, -depth) is not None:
             continue
         link = ctx.model.link(b) or ctx.model.link(a)
         yield Hit(f"links '{a}' and '{b}' interpenetrate by {depth_text(-depth)} at the home pose in MuJoCo",
-                  link.element if link else None)
+                  link.element if link else None, hint=srdf_hint(M003_FIX, note))
 
 
 def merge_home_contacts(findings: list) -> list:

@@ -245,26 +245,33 @@ def mass_tiny(ctx) -> Iterator[Hit]:
       (PhysX and Unity advise keeping connected masses within 1:10; maximal-coordinate engines drift
       and jitter). Reduced-coordinate engines (PyBullet's multibody, MuJoCo, Drake) tolerate far more,
       so only ratios beyond 1000:1 are reported: at that point even they need small time steps, and
-      the light link is usually a frame that should be fixed or a mass in the wrong unit.""",
+      the light link is usually a frame that should be fixed or a mass in the wrong unit. What a joint
+      moves is its child and everything below it, and that is the side judged: a light parent is a link
+      between two moving joints (the virtual links of a planar base, biped2d's x/z sliders), carried on
+      both sides, or a root, static when the robot is fixed.""",
       fix="Check both masses (kg); merge a frame-only link into its parent with a fixed joint.",
       bad=arm(link_extra='<inertial><mass value="0.002"/><inertia ixx="1e-7" ixy="0" ixz="0" iyy="1e-7" iyz="0" izz="1e-7"/></inertial>',
               base_extra='<inertial><mass value="50"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>'),
       good=arm(base_extra='<inertial><mass value="5"/><inertia ixx="0.1" ixy="0" ixz="0" iyy="0.1" iyz="0" izz="0.1"/></inertial>'),
-      thresholds=f"Heavier / lighter above {MAX_MASS_RATIO:g} across a moving joint, each side's mass being its rigid "
-                 f"group's (links welded by fixed joints); a side lighter than {MIN_MASS:g} kg is I014's alone.",
+      thresholds=f"Parent side / child side above {MAX_MASS_RATIO:g} across a moving joint, the parent side's mass "
+                 f"being its rigid group's (links welded by fixed joints), the child side's its subtree's (what the "
+                 f"joint moves); a child side lighter than {MIN_MASS:g} kg is I014's alone.",
       references="Unity Manual, Joint and Ragdoll stability (PhysX: mass ratios below 10); MuJoCo documentation, "
                  "Computation.")
 def mass_ratio(ctx) -> Iterator[Hit]:
     model = ctx.model
     group = rigid_masses(model)
+    carried = subtree_masses(model)
     for joint in model.joints:
         if not joint.moves or joint.parent not in group or joint.child not in group:
             continue
-        masses = [group[joint.parent], group[joint.child]]
+        masses = [group[joint.parent], carried[joint.child]]
         if not all(m > 0 for m in masses):
             continue
         light, heavy = min(masses), max(masses)  # type: ignore[type-var]
+        if masses[0] < masses[1]:
+            continue  # the light side holds what the joint moves: a link between two joints, or a root (static when fixed)
         if light >= MIN_MASS and heavy / light > MAX_MASS_RATIO:
             yield Hit(f"joint '{joint.name}' connects {masses[0]:g} kg ('{joint.parent}' and what is welded to it) and "
                       f"{masses[1]:g} kg "
-                      f"('{joint.child}'): ratio {heavy / light:.0f}:1", joint.element)
+                      f"('{joint.child}' and what it carries): ratio {heavy / light:.0f}:1", joint.element)

@@ -66,6 +66,10 @@ def sim_load_failed(ctx) -> Iterator[Hit]:
     body.remove()
 
 
+P002_FIX = ("Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
+                     "(SRDF / setCollisionFilterPair).")
+
+
 def _stacked_boxes(tip_z: float) -> str:
     """P002's example: base and tip boxes joined through a small middle link; overlapping when tip_z < 0."""
     return robot(f"""
@@ -87,10 +91,23 @@ def _stacked_boxes(tip_z: float) -> str:
       Adjacent is MoveIt's rule, as in sample-collisions: joined by a joint, looking through links
       without collision geometry (their overlap is by construction). Links joined only through
       fixed joints (one rigid group, as sample-collisions settles them) are not reported: they can
-      never move apart, so their overlap is how the part is built, not a pose to fix.""",
-      fix="Fix the collision geometry or the joint origin; if the overlap is by design, disable the pair "
-          "(SRDF / setCollisionFilterPair).",
+      never move apart, so their overlap is how the part is built, not a pose to fix. Nor are the pairs
+      an SRDF disables: the one --srdf names, else the one the package ships for this robot (an .srdf
+      beside the file, or in srdf/ or config/ next to it or next to its urdf/ folder, named like the file
+      or naming the robot; the hint says which). Nor are the contacts a robot is built with, which no
+      pose removes: links on either side of a joint cluster (a ball or universal joint written as two or
+      three revolute joints at one point: the links meet at its centre), the two branches of one
+      linkage driven through <mimic> (the halves of a four-bar URDF cannot close meet at the pin), two
+      branches whose hulls touch by at most 3 mm (neighbouring fingers at rest), and a link that collides
+      as a placeholder (a collision under 5% of its visual). A contact across a single joint, or across
+      joints that do not meet at one point, is kept: a part sunk into its mount is real.""",
+      fix=P002_FIX,
       bad=_stacked_boxes(tip_z=-0.25), good=_stacked_boxes(tip_z=0.25),
+      thresholds="Deeper than 1 µm; not reported: a joint cluster (at least two moving joints on the chain between the "
+                 "links, all within CLUSTER_RADIUS = 3 cm and half the smaller link's size of each other at the zero "
+                 "pose), one linkage (two branches whose moving joints all follow one leader through <mimic>), two "
+                 "branches touching by at most TOUCH_DEPTH = 3 mm, a collision under PLACEHOLDER = 5% of its link's "
+                 "visual.",
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import nonadjacent_collisions, rigid_groups
@@ -102,14 +119,105 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
             return
         body.set_positions(home)
         group = rigid_groups(ctx.model, (joint.name for joint in body.actuated_joints))
+        disabled, note = ctx.disabled_pairs()
         for a, b, depth in nonadjacent_collisions(body):
-            if is_disabled(ctx.srdf_disabled, a, b):
-                continue  # the user's SRDF tells MoveIt not to check this pair
+            if is_disabled(disabled, a, b):
+                continue  # the SRDF (the user's, or the package's) tells MoveIt not to check this pair
             if a in group and group[a] == group.get(b):
                 continue  # joined only by fixed joints: they can never move apart (issue 30 item 8)
+            if built_touching(ctx, a, b, -depth) is not None:
+                continue
             link = ctx.model.link(b) or ctx.model.link(a)
             yield Hit(f"links '{a}' and '{b}' interpenetrate by {depth_text(-depth)} at the home pose",
-                      link.element if link else None)
+                      link.element if link else None, hint=srdf_hint(P002_FIX, note))
+
+
+CLUSTER_RADIUS = 0.03
+"""m: the moving joints on the chain between two links all within this distance of each other (at the zero pose),
+and within half the smaller link's size, make a joint cluster: a ball or universal joint written as two or three
+revolute joints at one point (iCub's shoulder: 1.6 and 2.6 cm apart; its elbow, 4.5 cm, is two joints). The
+links on either side meet at its centre by construction."""
+TOUCH_DEPTH = 0.003
+"""m: links on two branches of the tree (two fingers of a hand) whose hulls overlap this little at home are at rest
+side by side: a convex hull of a curved part reaches where the part does not."""
+PLACEHOLDER = 0.05
+"""A link whose collision shapes' box is smaller than this fraction of its visual's collides as a placeholder
+(Baxter's screen: a 1 mm sphere for a 27 cm body): where that point sits says nothing about the part."""
+
+
+def built_touching(ctx, a: str, b: str, depth: float) -> str | None:
+    """Why links ``a`` and ``b``, overlapping ``depth`` m at home, meet there by construction (P002, M003), or None
+    when their contact is worth a warning. On one chain: a joint cluster between them (at least two moving
+    joints, all within CLUSTER_RADIUS and half the smaller link's size of each other). On two branches of the
+    tree: one linkage (every moving joint on the path driven by one actuator through <mimic>: the halves of a
+    four-bar URDF cannot close meet at its pin, parallel fingers at their closed home), or hulls touching by at
+    most TOUCH_DEPTH (neighbouring fingers at rest). Either way: a link whose collision is a placeholder."""
+    if _placeholder(ctx, a) or _placeholder(ctx, b):
+        return "a placeholder collision"
+    path = _tree_path(ctx, a, b)
+    if path is None:
+        return None
+    joints, branches = path
+    moving = [joint for joint in joints if joint.moves]
+    if not branches:
+        if len(moving) < 2:
+            return None
+        points = [frame[1] for joint in moving if joint.child and (frame := ctx.zero_pose_frame(joint.child)) is not None]
+        sizes = [size for name in (a, b) if (size := ctx.link_size(ctx.model.link(name))) is not None]
+        spread = max(math.dist(p, q) for p in points for q in points) if len(points) == len(moving) else math.inf
+        return "a joint cluster" if spread <= min([CLUSTER_RADIUS, *(size / 2 for size in sizes)]) else None
+    if len(moving) > 1 and len({_leader(ctx.model, joint) for joint in moving}) == 1:
+        return "one linkage"
+    if depth <= TOUCH_DEPTH:
+        return "branches touching"
+    return None
+
+
+def _placeholder(ctx, name: str) -> bool:
+    """Whether link ``name`` collides as a placeholder: its collision box under PLACEHOLDER of its visual's."""
+    link = ctx.model.link(name)
+    if link is None or not link.visuals or not link.collisions:
+        return False
+    sizes = []
+    for shapes in (link.collisions, link.visuals):
+        boxes = [ctx.shape_bounds(shape) for shape in shapes]
+        if any(box is None for box in boxes):
+            return False
+        sizes.append(max(math.dist(*box) for box in boxes))
+    return sizes[0] < PLACEHOLDER * sizes[1]
+
+
+def _tree_path(ctx, a: str, b: str):
+    """(the joints on the tree path between links ``a`` and ``b``, whether the path turns at a third body: two
+    branches), or None when they are not in one tree. Bodies are links welded by fixed joints: a cap welded to
+    the torso turns nowhere on its way to the arm."""
+    model = ctx.model
+    up_a, up_b = list(model.joints_above(a)), list(model.joints_above(b))
+    above_a = [a] + [joint.parent for joint in up_a]
+    above_b = [b] + [joint.parent for joint in up_b]
+    common = next((name for name in above_a if name in set(above_b)), None)
+    if common is None or any(model.link(name) is None for name in (a, b, common)):
+        return None
+    joints = up_a[:above_a.index(common)] + up_b[:above_b.index(common)]
+    tops = {ctx.rigid_body(model.link(name)).top for name in (a, b)}
+    return joints, ctx.rigid_body(model.link(common)).top not in tops
+
+
+def _leader(model, joint) -> str:
+    """The joint that drives ``joint`` through <mimic> chains (itself when it has none; a cycle stops)."""
+    seen = set()
+    while joint.mimic is not None and joint.name not in seen:
+        seen.add(joint.name)
+        leader = model.joint(joint.mimic.joint)
+        if leader is None:
+            break
+        joint = leader
+    return joint.name
+
+
+def srdf_hint(fix: str, note: str | None) -> str | None:
+    """A P002/M003 hint that says which SRDF's pairs were left out (None: the rule's own)."""
+    return None if note is None else f"{fix} ({note[0].upper()}{note[1:]}.)"
 
 
 def depth_text(depth: float) -> str:
@@ -247,8 +355,10 @@ def _swinging_arm(limit: float) -> str:
       full turn; the other joints at home, mimic joints following) and measures how deep the child's
       collision geometry sinks into its parent's (the nearest ancestor with collision geometry). Real
       parent and child meshes overlap at the joint at every angle, by design: only the depth *added*
-      relative to the home pose counts. Children without collision geometry and prismatic joints without
-      limits are skipped; at most
+      relative to the home pose counts. Children without collision geometry are skipped, and so are
+      prismatic joints: a child sliding into its parent is how telescopic lifts, sleeves and retracting
+      poles are built (ARMAR-6's torso, R2-D2's gripper pole), which convex hulls cannot tell from a
+      solid. At most
       MAX_SWEPT_JOINTS = 64 joints are swept, so a huge robot stays fast.""",
       fix="Fix the joint limits (the child should stop where it meets its parent) or the collision geometry "
           "(a convex hull of a concave part fills its hollow: split it or use a simpler shape).",

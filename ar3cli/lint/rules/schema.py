@@ -191,7 +191,8 @@ def _unknown_children(ctx) -> Iterator[tuple]:
       axis at 1 0 0, a <mass> written directly in <link> gives the link no mass at all, and the file
       still loads everywhere. Extensions are not reported: <gazebo>, <transmission>, <ros2_control>,
       <sensor>, <mujoco> and other top-level elements that are not close to a URDF name, namespaced
-      elements (drake:, xacro:), PyBullet's <contact> in <link>.""",
+      elements (drake:, xacro:), PyBullet's <contact> in <link>; nor is an identity <origin> (all zeros)
+      where none is read (directly in <link>): ignored, it loses nothing.""",
       fix="Rename the element to the one the message suggests, or move it where it belongs.",
       bad=arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/>').replace(
           '<axis xyz="0 0 1"/>', '<axes xyz="0 0 1"/>'),
@@ -203,6 +204,8 @@ def _unknown_children(ctx) -> Iterator[tuple]:
                  "multibody/parsing/detail_urdf_parser.cc.")
 def unknown_element(ctx) -> Iterator[Hit]:
     for parent, child, guess in _unknown_children(ctx):
+        if not guess and child.tag == "origin" and _identity_origin(child):
+            continue  # an identity <origin> where none is read: ignored, and nothing the author meant is lost
         homes = [home for home in _home_of(child.tag) if home != parent.tag]
         if guess:
             advice = f"did you mean <{guess}>?"
@@ -212,6 +215,14 @@ def unknown_element(ctx) -> Iterator[Hit]:
             hint = f"Move <{child.tag}> into <{homes[0]}>."
         yield Hit(f"{owner(parent)} has an unknown child <{child.tag}> ({advice}): {WHAT_PARSERS_DO}", child,
                   hint=hint)
+
+
+def _identity_origin(element) -> bool:
+    """An ``<origin>`` whose every number is 0 (or that has none): the frame it would give is the default."""
+    from ar3cli.urdf.model import parse_floats
+
+    values = [parse_floats(element.get(key)) for key in ("xyz", "rpy") if element.get(key) is not None]
+    return element.get("quat_xyzw") is None and all(v is not None and not any(v) for v in values)
 
 
 @rule("S017", "unknown-attribute", "warning", "Attribute the URDF spec does not have on this element",

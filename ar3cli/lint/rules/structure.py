@@ -68,7 +68,8 @@ def duplicate_joint(ctx) -> Iterator[Hit]:
 
 
 @rule("S004", "missing-link", "error", "Joint names a link that does not exist",
-      refused_by=("ros", "pybullet"), breaks="urdfdom and PyBullet refuse the file.",
+      refused_by=("ros", "pybullet", "mujoco"),
+      breaks="urdfdom, PyBullet and MuJoCo refuse the file (MuJoCo 4.0: \"URDF joint parent or child missing\").",
       why="A joint whose <parent> or <child> is missing or names an unknown link cannot be built by any tool.",
       fix="Fix the link name (check the spelling) or add the link.",
       bad=robot("""
