@@ -100,3 +100,28 @@ def test_fix_inertia_rescales_a_mass_in_grams_and_a_tensor_in_kg_mm2(cli, tmp_pa
 def _lint(path: Path, codes) -> list:
     options = LintOptions(select=list(codes))
     return lint_file(path, options.rules(), options).findings
+
+
+def test_fix_inertia_names_the_densities_it_does_not_touch(cli, tmp_path):
+    """I013 names fix-inertia for a mass in grams only: a density no material has that is not grams
+    (200 kg in an 8x8x30 cm box, 1e5 kg/m³, and still 104 kg/m³ read as grams, far from the arm's other
+    links) is left alone, and said so (the real-robot sweep's tiago arm_tool_link, pybullet_data's chest)."""
+    path = tmp_path / "arm.urdf"
+    path.write_text((UNITS / "arm_with_boxes.urdf").read_text().replace('<mass value="2.0"/>', '<mass value="200"/>'))
+    (finding,) = _lint(path, ("I013",))
+    assert "denser than any material" in finding.message and "grams" not in finding.message
+    before = path.read_bytes()
+    result = cli("fix-inertia", str(path))
+    assert result.code in (0, 1), result.stderr
+    assert "density no material has alone (I013, not a mass in grams): upper" in result.stdout + result.stderr
+    assert path.read_bytes() == before
+
+
+def test_density_is_judged_on_the_collision_alone_when_a_link_has_no_visual(tmp_path):
+    text = (UNITS / "arm_with_boxes.urdf").read_text().replace('<mass value="2.0"/>', '<mass value="200"/>')
+    without_visual = text.replace('<visual><origin xyz="0 0 0.15"/><geometry><box size="0.08 0.08 0.3"/></geometry>'
+                                  '</visual>', "")
+    assert without_visual != text
+    path = tmp_path / "arm.urdf"
+    path.write_text(without_visual)
+    assert [f.message.split(" is ")[0] for f in _lint(path, ("I013",))] == ["link 'upper'"]

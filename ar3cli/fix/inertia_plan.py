@@ -226,12 +226,21 @@ def _rescale_units(model, document: Document, plan: FixPlan, options: InertiaOpt
     from ar3cli.lint.context import Context
     from ar3cli.lint.engine import suppressed_inline
     from ar3cli.lint.rules.inertia import unit_mistakes
+    from ar3cli.lint.rules.plausibility import density_implausible
 
     context = Context(model)
     try:
         mistakes = unit_mistakes(context)
+        implausible = [hit for hit in density_implausible.check(context)
+                       if not suppressed_inline(hit.element, density_implausible.code)]
     finally:
         context.close()
+    unexplained = [name for hit in implausible if (owner := _owning_link(hit.element)) is not None
+                   and (name := owner.get("name", "")) not in mistakes and name not in options.masses]
+    if unexplained:  # I013 names fix-inertia for grams only: say which densities it did not touch, and why
+        plan.notes.append(f"left {len(unexplained)} link(s) whose density no material has alone (I013, not a mass in "
+                          f"grams): {listed(unexplained)}; check their <mass> and collision sizes, or recompute "
+                          "with --links NAME --density KG_PER_M3")
     done: set[str] = set()
     for name, (mass_divisor, tensor_divisor, reason) in mistakes.items():
         link = model.link(name)

@@ -120,6 +120,8 @@ def _density_bounds(ctx, link) -> tuple[float | None, float | None]:
     highest = mass / largest if largest > 0 else None
     volumes = []
     for shapes in (link.collisions, link.visuals):  # the drawn part may be the real one (contact spheres)
+        if not shapes:
+            continue  # no visual: the collision shapes alone bound the volume
         boxes = [_box_volume(ctx, shape) for shape in shapes]
         if not boxes or not all(v is not None and v > 0 for v in boxes):
             return highest, None  # a shape of unknown or flat size: no upper bound on the volume
