@@ -180,10 +180,13 @@ def test_places_searched_outside_the_tree_are_counted_not_named(cli, tmp_path):
     (repo / "r.urdf").write_text(robot(f'<link name="base">{LINK_INERTIAL}<collision><geometry>'
                                        '<mesh filename="package://nopkg/m.stl"/></geometry></collision></link>'))
     document = _json(cli("lint-urdf", "-f", "json", "r.urdf", cwd=repo))
-    [message] = [f["message"] for f in document["findings"] if f["rule"] == "G001"]
-    assert str(tmp_path) not in message and "/work/" not in message, message
+    [finding] = [f for f in document["findings"] if f["rule"] == "G001"]
+    message, hint = finding["message"], finding["hint"]
+    assert str(tmp_path) not in message + hint and "/work/" not in message + hint, (message, hint)
     assert message.endswith("looked in ancestors of the robot's folder named nopkg or with package.xml "
-                            f"<name>nopkg</name>, nopkg/m.stl, {len(repo.parents)} places outside the robot's folder")
+                            "<name>nopkg</name> and 2 more places")  # the hint names every one
+    assert hint.endswith("Looked in: ancestors of the robot's folder named nopkg or with package.xml "
+                         f"<name>nopkg</name>; nopkg/m.stl; {len(repo.parents)} places outside the robot's folder.")
 
 
 # ---- no secret on the page -----------------------------------------------------------------------

@@ -104,3 +104,16 @@ def test_the_pre_commit_hook_passes_a_package_with_macro_files(tmp_path):
     output = committed.stdout + committed.stderr
     assert committed.returncode == 0, output
     assert "S011" not in output and "S001" not in output
+
+
+def test_an_includer_names_the_file_in_an_include_not_anywhere_in_its_text(tmp_path):
+    """``e.xacro`` inside ``.secret_name.xacro`` made a stranger's include of a secret an includer of
+    ``e.xacro`` (its F004 became an F008 info: existence told apart); a glob that matches the name counts."""
+    from ar3cli.urdf.macro_library import includers
+
+    (tmp_path / "e.xacro").write_text("<robot/>")
+    (tmp_path / "d.xacro").write_text('<robot><xacro:include filename="parts/.secret_name.xacro"/></robot>')
+    assert includers(tmp_path / "e.xacro") == ()
+    (tmp_path / "g.xacro").write_text("<robot><xacro:include filename='$(find p)/*.xacro'/></robot>")
+    (tmp_path / "h.urdf").write_text('<robot><include filename="sub/e.xacro" /></robot>')
+    assert sorted(Path(name).name for name in includers(tmp_path / "e.xacro")) == ["g.xacro", "h.urdf"]

@@ -10,7 +10,9 @@ next to it that include it, where that is cheap to find.
 
 from __future__ import annotations
 
+import fnmatch
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -34,6 +36,8 @@ MAX_CANDIDATE_BYTES = 4 * 1024 * 1024
 """A candidate entry file larger than this is not read for the hint."""
 MAX_LEVELS = 3
 """Folders above the library's where its package.xml is looked for (``urdf/legs/leg.xacro``)."""
+INCLUDE_FILENAME = re.compile(rb"""<(?:xacro:)?include\b[^>]*?\bfilename\s*=\s*(["'])(.*?)\1""", re.DOTALL)
+"""An include's filename attribute (xacro's, or the pre-namespace ``<include>``)."""
 MAX_FOLDERS = 200
 """Folders of the package walked for the hint."""
 
@@ -150,7 +154,7 @@ def includers(path: Path) -> tuple[str, ...]:
                 text = read_bytes(candidate, limit=MAX_CANDIDATE_BYTES)
             except UserError:
                 continue
-            if name in text and b"include" in text:
+            if _includes_name(text, name):
                 relative = os.path.relpath(candidate)
                 found.append(str(candidate) if relative.startswith("..") else relative)
             if len(found) >= 3 or files_seen >= MAX_CANDIDATES:
@@ -158,3 +162,14 @@ def includers(path: Path) -> tuple[str, ...]:
         if folders >= MAX_FOLDERS:
             break
     return tuple(found)
+
+
+def _includes_name(text: bytes, name: bytes) -> bool:
+    """Whether ``text`` has an include whose filename's last component is ``name`` or a pattern matching it
+    (``$(find arm)/urdf/hand.xacro``, ``parts/*.xacro``). A name inside another (``e.xacro`` in
+    ``.secret_name.xacro``) is not one: that said a stranger's file was an include body."""
+    for match in INCLUDE_FILENAME.finditer(text):
+        last = match.group(2).replace(b"\\", b"/").rsplit(b"/", 1)[-1]
+        if last == name or (b"*" in last or b"?" in last or b"[" in last) and fnmatch.fnmatchcase(name, last):
+            return True
+    return False
