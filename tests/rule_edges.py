@@ -11,7 +11,8 @@ without edges fails there, saying what to add.
 The simulation rules' thresholds that live in a pure function (the speed a settled joint may keep, the
 relative difference P003 tolerates) are tested on that function: ``fires`` and ``quiet`` are then
 callables answering "does the rule report this?", and the edge is *pure*. The others (P002, P005, M003)
-use the smallest robots that reach them: two spheres, whose overlap is exact in both engines.
+use the smallest robots that reach them: spheres, whose overlap is exact in both engines (P005 swings one on a hinge
+to a limit computed to sink it a given depth: it sweeps no prismatic joint).
 
 A few named constants are not values anything is compared with (how long a robot settles, how many
 values a sweep tries): :data:`NOT_COMPARED` says so, one reason each.
@@ -206,6 +207,15 @@ def masses(base: float, arm_mass: float) -> str:
     return arm(base_extra=tensor(0.1, 0.1, 0.1, base), link_extra=tensor(1e-9, 1e-9, 1e-9, arm_mass))
 
 
+def planar_base(carried: float) -> str:
+    """A chassis of ``carried`` kg moved in the plane through a virtual x link without <inertial> (a prismatic
+    joint from a geometry-less root, then the yaw joint): Clearpath's Ridgeback in one axis (I017)."""
+    return robot(f"""
+        {link("odom", "")}{link("x_link", "")}{link("chassis", tensor(4, 8, 10, carried))}
+        {joint("x", "odom", "x_link", "prismatic", axis="1 0 0", extra=limit(-100, 100))}
+        {joint("yaw", "x_link", "chassis")}""")
+
+
 TALL = math.dist((-0.025, -0.025, 0.0), (0.025, 0.025, 0.3))
 """m: the diagonal of the arm's 0.05 x 0.05 x 0.3 box below."""
 
@@ -234,32 +244,73 @@ CUBE = {"meshes/cube.stl": box_stl(1.0)}
 """A 1 m cube, scaled by each document."""
 
 
-def scaled(visual: str, collision: str | None = None) -> Doc:
-    """One link drawn (and collided) with the 1 m cube at these scales."""
+def scaled(visual: str, collision: str | None = None, more: str = "") -> Doc:
+    """One link drawn (and collided) with the 1 m cube at these scales, and ``more`` of the robot."""
     shapes = f'<visual><geometry><mesh filename="meshes/cube.stl" scale="{visual}"/></geometry></visual>'
     if collision is not None:
         shapes += f'<collision><geometry><mesh filename="meshes/cube.stl" scale="{collision}"/></geometry></collision>'
-    return Doc(robot(link("base", LINK_INERTIAL + shapes)), CUBE)
+    return Doc(robot(link("base", LINK_INERTIAL + shapes) + more), CUBE)
 
 
 def uniform(factor: float) -> str:
     return " ".join([repr(factor)] * 3)
 
 
+def spanned(span: float) -> Doc:
+    """The 1 m cube scaled to 6 m on a robot whose kinematic span is ``span``: a frame welded that far away (G006)."""
+    return scaled(uniform(6.0), more=link("frame", "") + joint("weld", "base", "frame", "fixed", xyz=f"{span!r} 0 0"))
+
+
 def marker(side: float, mass: float = 1.0) -> str:
-    """A link drawn as a cube of ``side`` with no collision, weighing ``mass``, welded to two 1 m parts."""
+    """A link drawn as a cube of ``side`` with no collision, weighing ``mass``, welded 2 m above two 1 m parts
+    (outside their collisions, which would enclose it)."""
     return robot(f"""
         {link("base", LINK_INERTIAL + both("1 1 1"))}{link("body", LINK_INERTIAL + both("1 1 1"))}
         {link("marker", tensor(1e-6, 1e-6, 1e-6, mass) + box(uniform(side), role="visual"))}
-        {joint("weld", "base", "body", "fixed")}{joint("tag", "body", "marker", "fixed")}""")
+        {joint("weld", "base", "body", "fixed")}{joint("tag", "body", "marker", "fixed", xyz="0 0 2")}""")
 
 
 def light_marker(mass: float) -> str:
-    """A 0.5 m visual-only link of ``mass`` on a 1 kg robot."""
+    """A 0.5 m visual-only link of ``mass`` welded 2 m above a 1 kg robot (outside its collision)."""
     return robot(f"""
         {link("base", LINK_INERTIAL + both("1 1 1"))}
         {link("marker", tensor(1e-9, 1e-9, 1e-9, mass) + box("0.5 0.5 0.5", role="visual"))}
-        {joint("tag", "base", "marker", "fixed")}""")
+        {joint("tag", "base", "marker", "fixed", xyz="0 0 2")}""")
+
+
+def frame_drawing(side: float) -> str:
+    """A link without <inertial> drawn as a cube of ``side``, welded 2 m above a 1 m part: a frame drawn for people
+    when its box is smaller than half its parent's (G008)."""
+    return robot(f"""
+        {link("base", LINK_INERTIAL + both("1 1 1"))}{link("frame", box(uniform(side), role="visual"))}
+        {joint("weld", "base", "frame", "fixed", xyz="0 0 2")}""")
+
+
+def corners(low: tuple[float, float, float], high: tuple[float, float, float]) -> str:
+    """A collision box from ``low`` to ``high``."""
+    centre = " ".join(repr((a + b) / 2) for a, b in zip(low, high))
+    return box(" ".join(repr(b - a) for a, b in zip(low, high)), centre)
+
+
+def enclosed(inside: int) -> str:
+    """A 1 m visual-only part (its box 0..1 on each axis) on a hinge, ``inside`` (56 to 60) of the 4 x 4 x 4 cell
+    centres G008 samples in its box covered by its parent's three collision boxes: x < 0.75 (48), then y < 0.5
+    (8), then y < 0.75 and z < (inside - 56) / 4 (a point per quarter: the centres sit at 0.125, 0.375, ...)."""
+    covers = (corners((-1, -1, -1), (0.75, 2, 2)) + corners((0.75, -1, -1), (2, 0.5, 2))
+              + corners((0.75, 0.5, -1), (2, 0.75, (inside - 56) / 4)))
+    return robot(f"""
+        {link("base", LINK_INERTIAL + covers)}{link("part", LINK_INERTIAL + box("1 1 1", "0.5 0.5 0.5", "visual"))}
+        {joint("j1", "base", "part")}""")
+
+
+def enclosed_from(frames: int) -> str:
+    """A 0.5 m visual-only part inside the 2 m collision cube of the base, ``frames + 1`` joints up the chain through
+    geometry-less links (G008 looks for covers NEIGHBOUR_DEPTH joints away)."""
+    chain = ["base", *(f"frame{index}" for index in range(frames)), "part"]
+    links = [link("base", LINK_INERTIAL + box("2 2 2")), *(link(name) for name in chain[1:-1]),
+             link("part", LINK_INERTIAL + box("0.5 0.5 0.5", role="visual"))]
+    joints = [joint(f"j{index}", parent, child) for index, (parent, child) in enumerate(zip(chain, chain[1:]))]
+    return robot("".join(links + joints))
 
 
 def stl(triangles: int, extra: bytes = b"") -> Doc:
@@ -381,30 +432,54 @@ def colour(rgba: str) -> str:
 
 # ---- P, M: simulation --------------------------------------------------------------------------------------
 
-def sphere(radius: float) -> str:
-    return f'<collision><geometry><sphere radius="{radius!r}"/></geometry></collision>'
+def sphere(radius: float, xyz: str = "0 0 0") -> str:
+    return f'<collision><origin xyz="{xyz}"/><geometry><sphere radius="{radius!r}"/></geometry></collision>'
 
 
-def sliding_ball(radius: float, travel: float, gap: float = 0.02, before: int = 0) -> str:
-    """Two spheres of ``radius``, ``gap`` apart at home; the child slides ``travel`` into its parent on a
-    prismatic joint (overlap = travel - gap, exact). ``before`` geometry-less revolute joints come first."""
+SWING = 0.5
+"""m: how far the ball below swings from its hinge, and the hinge from the base's centre."""
+
+
+def swinging_ball(radius: float, depth: float, before: int = 0) -> str:
+    """Two spheres of ``radius``; the child's centre is SWING from a hinge that stands SWING from the parent's, so
+    at angle θ the centres are 2 SWING sin((π/2 - θ) / 2) apart (0.71 m at home): the upper limit is the angle that
+    sinks it ``depth`` into its parent, exactly. ``before`` geometry-less revolute joints come first."""
+    upper = math.pi / 2 - 2 * math.asin((2 * radius - depth) / (2 * SWING))
     fillers = [link(f"l{index}") for index in range(before)]
     chain = ["base", *(f"l{index}" for index in range(before))]
     joints = [joint(f"j{index}", parent, child, extra=limit(-0.1, 0.1))
               for index, (parent, child) in enumerate(zip(chain, chain[1:]))]
     return robot(f"""
         {link("base", LINK_INERTIAL + sphere(radius))}{"".join(fillers)}
-        {link("ball", LINK_INERTIAL + sphere(radius))}{"".join(joints)}
-        {joint("slide", chain[-1], "ball", "prismatic", xyz=f"0 0 {2 * radius + gap!r}", axis="0 0 -1",
-               extra=limit(0, travel))}""")
+        {link("ball", LINK_INERTIAL + sphere(radius, f"{SWING} 0 0"))}{"".join(joints)}
+        {joint("swing", chain[-1], "ball", xyz=f"0 {-SWING} 0", extra=limit(0, upper))}""")
 
 
-def touching(overlap: float) -> str:
-    """Base and tip spheres (5 cm) overlapping by ``overlap`` at home, joined through a small middle link."""
+def touching(overlap: float, base_visual: str = "") -> str:
+    """Base and tip spheres (5 cm) overlapping by ``overlap`` at home, joined through a small middle link; the base
+    drawn as ``base_visual``."""
     return robot(f"""
-        {link("base", LINK_INERTIAL + sphere(0.05))}{link("mid", LINK_INERTIAL + sphere(0.01))}
+        {link("base", LINK_INERTIAL + sphere(0.05) + base_visual)}{link("mid", LINK_INERTIAL + sphere(0.01))}
         {link("tip", LINK_INERTIAL + sphere(0.05))}
         {joint("j1", "base", "mid", xyz="1 0 0")}{joint("j2", "mid", "tip", xyz=f"{-0.9 - overlap!r} 0 0")}""")
+
+
+def cluster(spread: float, tip: float = 0.05) -> str:
+    """A 5 cm base sphere and a tip sphere of radius ``tip`` deep in it, two hinges ``spread`` apart between them
+    (the first at the base's centre, through a 1 cm middle link): a joint cluster when the hinges are within
+    CLUSTER_RADIUS and half the smaller link's size (its box diagonal: 2√3 ``tip``) of each other (P002)."""
+    return robot(f"""
+        {link("base", LINK_INERTIAL + sphere(0.05))}{link("mid", LINK_INERTIAL + sphere(0.01))}
+        {link("tip", LINK_INERTIAL + sphere(tip))}
+        {joint("j1", "base", "mid")}{joint("j2", "mid", "tip", xyz=f"{spread!r} 0 0")}""")
+
+
+def fingers(overlap: float) -> str:
+    """Two 5 cm finger spheres on two hinges of a small base (two branches), overlapping by ``overlap`` at home."""
+    return robot(f"""
+        {link("base", LINK_INERTIAL + sphere(0.01))}
+        {link("left", LINK_INERTIAL + sphere(0.05))}{link("right", LINK_INERTIAL + sphere(0.05))}
+        {joint("j1", "base", "left", xyz="0 0 0.2")}{joint("j2", "base", "right", xyz=f"0 {0.1 - overlap!r} 0.2")}""")
 
 
 def settles_at(speed: float, fastest: float) -> Callable[[], bool]:
@@ -461,6 +536,7 @@ EDGES: dict[str, tuple[Edge, ...]] = {
     "I014": (Edge("MIN_MASS", masses(1, 0.99e-3), masses(1, 1.01e-3)),),
     "I015": (Edge("MAX_MASS_RATIO", masses(10.01, 0.01), masses(9.99, 0.01)),
              Edge("MIN_MASS", masses(100, 1.01e-3), masses(100, 0.99e-3))),
+    "I017": (Edge("PHANTOM_SHARE", planar_base(50.5), planar_base(49.5)),),  # 1 kg / 0.02 = 50 kg
     "I016": (Edge("COM_FACTOR", com_above(0.3 + 3.03 * TALL), com_above(0.3 + 2.97 * TALL)),
              Edge("COM_SCALE", small_com(0.025 + 0.505 * 2 * math.sqrt(3)), small_com(0.025 + 0.495 * 2 * math.sqrt(3)))),
     "G006": (Edge("MAX_PLAUSIBLE_EXTENT", scaled(uniform(5.05)), scaled(uniform(4.95))),
@@ -468,9 +544,13 @@ EDGES: dict[str, tuple[Edge, ...]] = {
              Edge("MIN_PLAUSIBLE_EXTENT", scaled(uniform(0.00099)), scaled(uniform(0.00101))),
              Edge("SCALE_MISMATCH", scaled(uniform(0.01), uniform(2.51)), scaled(uniform(0.01), uniform(2.49))),
              Edge("SCALE_MISMATCH", scaled(uniform(0.0011), uniform(0.0011 * 3999)),
-                  scaled(uniform(0.0011), uniform(0.0011 * 4001)))),
+                  scaled(uniform(0.0011), uniform(0.0011 * 4001))),
+             Edge("SPAN_FACTOR", spanned(1.98), spanned(2.02))),  # 6 m against 3.03 and 2.97 spans
     "G008": (Edge("MARKER_SIZE", marker(0.101), marker(0.099)),  # a tenth of the median link (√3 m), over √3
-             Edge("MARKER_MASS", light_marker(1.02e-4), light_marker(0.98e-4))),
+             Edge("MARKER_MASS", light_marker(1.02e-4), light_marker(0.98e-4)),
+             Edge("FRAME_DRAWING", frame_drawing(0.505), frame_drawing(0.495)),
+             Edge("ENCLOSED", enclosed(57), enclosed(58)),  # 57/64 = 0.89, 58/64 = 0.91: the grid allows no closer
+             Edge("NEIGHBOUR_DEPTH", enclosed_from(2), enclosed_from(1))),
     "G011": (Edge("84 + 50 x count", stl(1, extra=b"\0"), stl(1)),
              Edge("count >= 1", stl(0), stl(1)),
              Edge("MAX_MESH_BYTES", Doc(stl(0).text, {"meshes/part.stl": 64 * 1024 * 1024 + 1}),
@@ -491,7 +571,13 @@ EDGES: dict[str, tuple[Edge, ...]] = {
              Edge("AXIS_MIN", axis_offset(0.01 + 0.101, 0.02), axis_offset(0.01 + 0.099, 0.02))),
     "G017": (Edge("above 1", colour("1.01 0 0 1"), colour("1 0 0 1")),
              Edge("within 0-255", colour("255 0 0 1"), colour("255.1 0 0 1"))),
-    "P002": (Edge("1 um", touching(1.02e-6), touching(0.98e-6)),),
+    "P002": (Edge("1 um", touching(1.02e-6), touching(0.98e-6)),
+             Edge("CLUSTER_RADIUS", cluster(0.0303), cluster(0.0297)),
+             Edge("half the smaller link's size", cluster(0.02, 0.98 * 0.02 / math.sqrt(3)),
+                  cluster(0.02, 1.02 * 0.02 / math.sqrt(3))),
+             Edge("TOUCH_DEPTH", fingers(3.03e-3), fingers(2.97e-3)),
+             Edge("PLACEHOLDER", touching(1e-3, box(uniform(1.98), role="visual")),  # 5% of a 2 m cube's diagonal
+                  touching(1e-3, box(uniform(2.02), role="visual")))),
     "M003": (Edge("PENETRATION", touching(1.02e-6), touching(0.98e-6)),),
     "P003": (Edge("INERTIA_TOLERANCE", lambda: pybullet_sim._differs(0.899, 1.0),
                   lambda: pybullet_sim._differs(0.901, 1.0)),),
@@ -499,9 +585,9 @@ EDGES: dict[str, tuple[Edge, ...]] = {
                   settles_at(99, pybullet_sim.MAX_SETTLE_SPEED)),),
     "M004": (Edge("MAX_SETTLE_SPEED", settles_at(101, mujoco_rules.MAX_SETTLE_SPEED),
                   settles_at(99, mujoco_rules.MAX_SETTLE_SPEED)),),
-    "P005": (Edge("SIZE_FRACTION", sliding_ball(0.05, 0.02 + 0.0612), sliding_ball(0.05, 0.02 + 0.0588)),  # 0.6 x 0.1 m
-             Edge("MIN_NEW_DEPTH", sliding_ball(0.008, 0.02 + 0.0102), sliding_ball(0.008, 0.02 + 0.0098)),
-             Edge("MAX_SWEPT_JOINTS", sliding_ball(0.05, 0.1, before=63), sliding_ball(0.05, 0.1, before=64))),
+    "P005": (Edge("SIZE_FRACTION", swinging_ball(0.05, 0.0612), swinging_ball(0.05, 0.0588)),  # 0.6 x 0.1 m
+             Edge("MIN_NEW_DEPTH", swinging_ball(0.008, 0.0102), swinging_ball(0.008, 0.0098)),
+             Edge("MAX_SWEPT_JOINTS", swinging_ball(0.05, 0.1, before=63), swinging_ball(0.05, 0.1, before=64))),
 }
 """Rule code -> its thresholds' edges."""
 
