@@ -297,3 +297,26 @@ def test_mujocos_refusal_of_a_link_a_static_error_is_about_is_not_restated():
     assert _codes(restated) == ["S019", "S019"]  # MuJoCo's "missing element: 'mass'" is the same <inertial>
     kept = _lint("planar_base.urdf", select=("I001", "I017", "M001"), sim=True, engines=("mujoco",))
     assert "M001" in _codes(kept)  # virtual1 is an info for PyBullet; MuJoCo's refusal of it is news
+
+
+@pytest.mark.slow
+def test_a_body_collided_as_many_small_spheres_is_not_a_placeholder(tmp_path):
+    """P002 judged a placeholder collision by its largest shape alone: a 20 cm cube drawn, collided as
+    spheres of 8 mm at its corners (each 4% of the drawing), hid a tip sunk 3 mm into one of them. The box
+    around all of a link's collision shapes is what is compared with its drawing."""
+    from ar3cli.lint.rules.base import LINK_INERTIAL, robot
+
+    corners = "".join(f'<collision><origin xyz="{x} {y} {z}"/><geometry><sphere radius="0.004"/></geometry></collision>'
+                      for x in (-0.096, 0.096) for y in (-0.096, 0.096) for z in (-0.096, 0.096))
+    limit = '<axis xyz="0 0 1"/><limit lower="-1" upper="1" effort="10" velocity="1"/>'
+    text = robot(f"""
+        <link name="base">{LINK_INERTIAL}<visual><geometry><box size="0.2 0.2 0.2"/></geometry></visual>{corners}</link>
+        <link name="arm">{LINK_INERTIAL}<collision><geometry><sphere radius="0.01"/></geometry></collision></link>
+        <link name="tip">{LINK_INERTIAL}<collision><geometry><sphere radius="0.004"/></geometry></collision></link>
+        <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><origin xyz="0 0 0.5"/>{limit}</joint>
+        <joint name="j2" type="revolute"><parent link="arm"/><child link="tip"/>
+          <origin xyz="0.096 0.096 -0.399"/>{limit}</joint>""")
+    (tmp_path / "r.urdf").write_text(text)
+    options = LintOptions(select=["P002"], sim=True)
+    findings = lint_file(tmp_path / "r.urdf", options.rules(), options).findings
+    assert _pairs(findings) == {("base", "tip")}

@@ -13,6 +13,7 @@ from contextlib import contextmanager
 
 from ar3cli.errors import UserError
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, refusal_explained, robot, rule
+from ar3cli.lint.rules.geometry import union_box
 
 INERTIA_TOLERANCE = 0.10
 """Relative difference between the file and PyBullet's value above which P003 reports a link."""
@@ -174,7 +175,8 @@ def built_touching(ctx, a: str, b: str, depth: float) -> str | None:
 
 
 def _placeholder(ctx, name: str) -> bool:
-    """Whether link ``name`` collides as a placeholder: its collision box under PLACEHOLDER of its visual's."""
+    """Whether link ``name`` collides as a placeholder: the box around its collision shapes under PLACEHOLDER of
+    the box around its visual shapes (diagonals)."""
     link = ctx.model.link(name)
     if link is None or not link.visuals or not link.collisions:
         return False
@@ -183,7 +185,7 @@ def _placeholder(ctx, name: str) -> bool:
         boxes = [ctx.shape_bounds(shape) for shape in shapes]
         if any(box is None for box in boxes):
             return False
-        sizes.append(max(math.dist(*box) for box in boxes))
+        sizes.append(math.dist(*union_box(boxes)))  # all of them: 9,261 small spheres can fill a body
     return sizes[0] < PLACEHOLDER * sizes[1]
 
 
