@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from tests.conftest import REPO
+from tests.hook_project import hook_project
 
 PACKAGE = Path(__file__).parent / "data" / "xacro_library"
 LIBRARIES = ("urdf/leg.xacro", "urdf/materials.xacro", "urdf/utils/inertia.xacro")
@@ -76,31 +77,12 @@ def test_scan_stores_the_library_with_its_info_line(tmp_path):
     assert json.loads(rows[str((PACKAGE / "urdf" / "robot.urdf.xacro").resolve())]) == []
 
 
-def _git(*args: str, cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess:
-    return subprocess.run(["git", *args], cwd=cwd, env=env, capture_output=True, text=True, timeout=600)
-
-
 @pytest.mark.slow
 def test_the_pre_commit_hook_passes_a_package_with_macro_files(tmp_path):
     """As tests/test_pre_commit.py: the real pre-commit, this checkout as the hook repository."""
-    pytest.importorskip("pre_commit", reason="pre-commit is part of the test extra")
-    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=REPO, capture_output=True, text=True)
-    if head.returncode != 0:
-        pytest.skip("the checkout is not a git repository")
-    project = tmp_path / "robot_project"
-    shutil.copytree(PACKAGE, project)
-    env = {**os.environ, "PRE_COMMIT_HOME": str(tmp_path / "pre-commit-home"), "NO_COLOR": "1",
-           "GIT_AUTHOR_NAME": "t", "GIT_AUTHOR_EMAIL": "t@example.com",
-           "GIT_COMMITTER_NAME": "t", "GIT_COMMITTER_EMAIL": "t@example.com",
-           "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ.get('PATH', '')}"}
-    _git("init", "-q", cwd=project, env=env)
-    (project / ".pre-commit-config.yaml").write_text(
-        f"repos:\n  - repo: {REPO}\n    rev: {head.stdout.strip()}\n    hooks:\n      - id: ar3cli-lint\n")
-    installed = subprocess.run([sys.executable, "-m", "pre_commit", "install"], cwd=project, env=env,
-                               capture_output=True, text=True)
-    assert installed.returncode == 0, installed.stderr
-    _git("add", "-A", cwd=project, env=env)
-    committed = _git("commit", "-m", "a description package with macro files", cwd=project, env=env)
+    shutil.copytree(PACKAGE, tmp_path / "robot_project")
+    project = hook_project(tmp_path / "robot_project", tmp_path / "pre-commit-home")
+    committed = project.commit("a description package with macro files")
     output = committed.stdout + committed.stderr
     assert committed.returncode == 0, output
     assert "S011" not in output and "S001" not in output
