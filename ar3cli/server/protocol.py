@@ -68,6 +68,13 @@ class RobotLanguageServer(LanguageServer):
         with contextlib.suppress(Exception):  # the client is gone: stderr has it
             self.window_log_message(types.LogMessageParams(level, message))
 
+    def take_client_settings(self, settings) -> None:
+        """The editor's settings (initializationOptions or didChangeConfiguration) over the command line's; a
+        setting refused is one warning line in the editor's log."""
+        self.options, refused = self.options.with_client_settings(settings)
+        for line in refused:
+            self.say(line, types.MessageType.Warning)
+
     def text(self, uri: str) -> str | None:
         """The buffer's text (None when it is not open)."""
         try:
@@ -285,9 +292,7 @@ def build(options: ServerOptions) -> RobotLanguageServer:
     @server.feature(types.INITIALIZE)
     @guarded(lambda: None)
     def initialize(ls: RobotLanguageServer, params: types.InitializeParams) -> None:
-        ls.options, refused = ls.options.with_client_settings(params.initialization_options)
-        for line in refused:
-            ls.say(line, types.MessageType.Warning)
+        ls.take_client_settings(params.initialization_options)
         folders = [folder.uri for folder in params.workspace_folders or []]
         root = params.root_uri or (folders[0] if folders else None) or \
             (from_fs_path(params.root_path) if params.root_path else None)
@@ -359,9 +364,7 @@ def build(options: ServerOptions) -> RobotLanguageServer:
     @server.feature(types.WORKSPACE_DID_CHANGE_CONFIGURATION)
     @guarded(lambda: None)
     def did_change_configuration(ls: RobotLanguageServer, params: types.DidChangeConfigurationParams) -> None:
-        ls.options, refused = ls.options.with_client_settings(params.settings)
-        for line in refused:
-            ls.say(line, types.MessageType.Warning)
+        ls.take_client_settings(params.settings)
 
     @server.feature(types.SHUTDOWN)
     def shutdown(ls: RobotLanguageServer, params: Any) -> None:
