@@ -125,7 +125,7 @@ class SchemaWalk:
     ``nodes`` holds every element the schema rules judge (:func:`_urdf_nodes`), in the walk's order;
     ``odd`` those of them with a child the schema does not name there (an unknown element, an
     attribute written as an element, an extension, a comment), in the same order: the only nodes S016
-    and S018 can report, and one node in a hundred of a real robot."""
+    and S018 can report, and few in a real robot."""
 
     nodes: tuple[Node, ...]
     odd: tuple[Node, ...]
