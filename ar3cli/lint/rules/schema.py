@@ -355,6 +355,8 @@ VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "dec
 """Attribute -> element for the URDF 1.1/1.2 attributes (``<capsule>`` is G010's)."""
 VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
 """The elements that may hold one (S020 reads only their attributes)."""
+VERSION_FEATURE_NAMES = tuple(name.encode() for name in VERSION_FEATURE_ELEMENTS)
+"""Their names as a file's bytes spell them: without one of them, S020 has nothing to read."""
 
 
 @rule("S020", "undeclared-urdf-version", "info", "URDF 1.1/1.2 attribute in a file that does not declare it",
@@ -372,6 +374,8 @@ VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
       references="urdfdom README (URDF versioning) and urdf_parser/src/pose.cpp, joint.cpp; ros/urdfdom#238.")
 def undeclared_urdf_version(ctx) -> Iterator[Hit]:
     model = ctx.model
+    if not any(name in model.xml_bytes for name in VERSION_FEATURE_NAMES):
+        return  # no attribute can have a name the parsed bytes never spell (entities are refused): skip the walk
     for element, tag, _children in _schema_walk(ctx).nodes:
         if tag not in VERSION_FEATURE_HOLDERS:
             continue
