@@ -272,13 +272,15 @@ def _line_box_distance(direction, box: Box) -> float:
     axis): its minimum is at one of those breakpoints or at a piece's own minimum, clipped into the
     piece. That is a dozen evaluations (an 80-step ternary search cost G016 a quarter of a cold lint).
     """
+    lows, highs = box
+    if all(lo <= 0.0 <= hi for lo, hi in zip(lows, highs)):
+        return 0.0  # the line's own point at the joint origin is in the box (most hinges sit in their part)
     norm = math.sqrt(sum(v * v for v in direction))
     if math.isinf(norm):  # a huge axis (1e200): its squares overflowed
         norm = math.hypot(*direction)
     if not norm > 0:
         return 0.0
     u = [v / norm for v in direction]
-    lows, highs = box
 
     def distance(t: float) -> float:
         return vector_length([max(0.0, lo - t * a, t * a - hi) for a, lo, hi in zip(u, lows, highs)])

@@ -16,6 +16,7 @@ from __future__ import annotations
 import difflib
 import functools
 from collections.abc import Iterator
+from dataclasses import dataclass
 from typing import Any
 
 from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, arm, robot, rule
@@ -116,38 +117,52 @@ Node = tuple[Any, str, list[tuple[Any, Any]]]
 """(element, its tag, [(child, child's tag), ...] for every child, comments included)."""
 
 
+@dataclass(frozen=True)
+class SchemaWalk:
+    """The URDF part of a file, walked once for the five schema rules (lxml makes a new object and a
+    new tag string each time an element is reached: the walk is most of their cost).
+
+    ``nodes`` holds every element the schema rules judge (:func:`_urdf_nodes`), in the walk's order;
+    ``odd`` those of them with a child the schema does not name there (an unknown element, an
+    attribute written as an element, an extension, a comment), in the same order: the only nodes S016
+    and S018 can report, and few in a real robot."""
+
+    nodes: tuple[Node, ...]
+    odd: tuple[Node, ...]
+
+
 def _children(element) -> list[tuple[Any, Any]]:
     return [(child, child.tag) for child in element] if len(element) else []  # most are leaves: <origin/>
 
 
-def _urdf_nodes(root) -> Iterator[Node]:
+def _urdf_nodes(root) -> SchemaWalk:
     """Every element inside the robot's URDF part: <link>, <joint> and <material> children of <robot>
     and, below them, only children the schema knows (so an extension's subtree is never walked);
-    each with its children, read once for S016 and S018 (lxml makes a new object and a new tag
-    string each time a child is reached)."""
-    # ``child.tag in names`` is ``_local(child.tag) in names``: the schema's names are plain, and a
-    # comment's tag (a function) or a namespaced tag ("{uri}origin") is none of them.
-    stack = [child for child in root if child.tag in SCHEMA["robot"][1]]
+    each with its children, read once for every schema rule. Depth first, the last child first."""
+    # ``tag in names`` is ``_local(tag) in names``: the schema's names are plain, and a comment's tag
+    # (a function) or a namespaced tag ("{uri}origin") is none of them.
+    nodes: list[Node] = []
+    odd: list[Node] = []
+    stack = [(child, tag) for child in root if (tag := child.tag) in SCHEMA["robot"][1]]
     while stack:
-        element = stack.pop()
-        tag = element.tag
-        children = _children(element)
-        yield element, tag, children
-        if tag == "geometry":
+        element, tag = stack.pop()
+        if not len(element):  # a leaf (<origin/>, <mass/>): most elements
+            nodes.append((element, tag, []))
             continue
+        node = (element, tag, _children(element))
+        nodes.append(node)
         names = SCHEMA[tag][1]
-        if names:
-            stack.extend(child for child, child_tag in children if child_tag in names)
+        known = [pair for pair in node[2] if pair[1] in names]
+        if len(known) != len(node[2]):
+            odd.append(node)
+        if tag != "geometry":
+            stack += known
+    return SchemaWalk(tuple(nodes), tuple(odd))
 
 
-def _schema_nodes(ctx) -> tuple[Node, ...]:
+def _schema_walk(ctx) -> SchemaWalk:
     """:func:`_urdf_nodes` of the file, walked once for all the schema rules."""
-    return ctx.shared("schema-nodes", lambda model: tuple(_urdf_nodes(model.root)))
-
-
-def _schema_elements(ctx) -> tuple:
-    """The elements of :func:`_schema_nodes`, in the same order."""
-    return ctx.shared("schema-elements", lambda model: tuple(node[0] for node in _schema_nodes(ctx)))
+    return ctx.shared("schema-walk", lambda model: _urdf_nodes(model.root))
 
 
 def owner(element) -> str:
@@ -165,7 +180,7 @@ def owner(element) -> str:
 def _unknown_children(ctx) -> Iterator[tuple]:
     """(element, unknown child, closest allowed name or None) for every child the schema lacks."""
     root = ctx.model.root
-    for element, element_tag, element_children in ((root, root.tag, _children(root)), *_schema_nodes(ctx)):
+    for element, element_tag, element_children in ((root, root.tag, _children(root)), *_schema_walk(ctx).odd):
         attrs, children = SCHEMA[element_tag]
         if element_tag in GEOMETRY_SHAPES_OWNED_ELSEWHERE:
             continue
@@ -241,12 +256,13 @@ def _identity_origin(element) -> bool:
       references="wiki.ros.org/urdf/XML (link, joint); urdfdom xsd/urdf.xsd; urdfdom urdf_parser/src/pose.cpp, "
                  "joint.cpp, link.cpp.")
 def unknown_attribute(ctx) -> Iterator[Hit]:
-    for element in (ctx.model.root, *_schema_elements(ctx)):
-        attrs = SCHEMA[element.tag][0]
-        extra = ENGINE_EXTENSIONS.get(element.tag, (frozenset(), frozenset()))[0]
+    root = ctx.model.root
+    for element, tag, _children in ((root, root.tag, None), *_schema_walk(ctx).nodes):
+        attrs = SCHEMA[tag][0]
         names = element.keys()
         if attrs.issuperset(names):
             continue  # every attribute is the spec's (nearly always)
+        extra = ENGINE_EXTENSIONS.get(tag, (frozenset(), frozenset()))[0]
         for name in names:
             if name in attrs or name in extra or _local(name) is None:
                 continue
@@ -286,7 +302,7 @@ def _same_number(a: str | None, b: str | None) -> bool:
       good=arm(joint_extra='<limit lower="-1" upper="1" effort="10" velocity="1"/><dynamics damping="5"/>'),
       references="Drake issue #18796 (damping as an element silently ignored); urdfdom urdf_parser/src/joint.cpp.")
 def attribute_as_element(ctx) -> Iterator[Hit]:
-    for element, element_tag, element_children in _schema_nodes(ctx):
+    for element, element_tag, element_children in _schema_walk(ctx).odd:  # a child the schema names is no attribute
         attrs = SCHEMA[element_tag][0]
         if not attrs:
             continue
@@ -321,7 +337,7 @@ parseInertial: "Inertial element must have a mass element", "... inertia element
       references="urdfdom urdf_parser/src/link.cpp (parseVisual, parseCollision, parseInertial); IsaacSim #599.")
 def missing_required_child(ctx) -> Iterator[Hit]:
     moving = {joint.child for joint in ctx.model.joints if joint.moves}
-    for element, element_tag, element_children in _schema_nodes(ctx):
+    for element, element_tag, element_children in _schema_walk(ctx).nodes:
         required = REQUIRED_CHILDREN.get(element_tag)
         if not required:
             continue
@@ -339,6 +355,8 @@ VERSION_FEATURE_ELEMENTS = {"quat_xyzw": "origin", "acceleration": "limit", "dec
 """Attribute -> element for the URDF 1.1/1.2 attributes (``<capsule>`` is G010's)."""
 VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
 """The elements that may hold one (S020 reads only their attributes)."""
+VERSION_FEATURE_NAMES = tuple(name.encode() for name in VERSION_FEATURE_ELEMENTS)
+"""Their names as a file's bytes spell them: without one of them, S020 has nothing to read."""
 
 
 @rule("S020", "undeclared-urdf-version", "info", "URDF 1.1/1.2 attribute in a file that does not declare it",
@@ -356,11 +374,13 @@ VERSION_FEATURE_HOLDERS = frozenset(VERSION_FEATURE_ELEMENTS.values())
       references="urdfdom README (URDF versioning) and urdf_parser/src/pose.cpp, joint.cpp; ros/urdfdom#238.")
 def undeclared_urdf_version(ctx) -> Iterator[Hit]:
     model = ctx.model
-    for element in _schema_elements(ctx):
-        if element.tag not in VERSION_FEATURE_HOLDERS:
+    if not any(name in model.xml_bytes for name in VERSION_FEATURE_NAMES):
+        return  # no attribute can have a name the parsed bytes never spell (entities are refused): skip the walk
+    for element, tag, _children in _schema_walk(ctx).nodes:
+        if tag not in VERSION_FEATURE_HOLDERS:
             continue
         for name in element.keys():  # noqa: SIM118 - an lxml element: iterating it gives its children
-            if VERSION_FEATURE_ELEMENTS.get(name) == element.tag and not model.declares(name):
+            if VERSION_FEATURE_ELEMENTS.get(name) == tag and not model.declares(name):
                 major, minor = URDF_VERSION_FEATURES[name]
                 yield Hit(f"{owner(element)} uses {name}, which is URDF {major}.{minor}: the file does not declare it "
                           "(urdfdom ignores it)", element,
