@@ -52,6 +52,9 @@ BASE_ENV = {
     "PYTHONPYCACHEPREFIX": str(WORK / "pycache"),
     "AR3CLI_CACHE_DIR": str(WORK / "ar3cli-cache"),
     "NO_COLOR": "1",
+    # the ar3cli this checkout holds, whichever install the console script comes from (an editable install of
+    # another worktree ran that one's code under this one's "source: commit" line)
+    "PYTHONPATH": os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH", "")])),
 }
 
 
