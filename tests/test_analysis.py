@@ -275,6 +275,24 @@ def test_the_verdict_is_built_from_every_section(tmp_path):
     assert json.loads(json.dumps(result.to_dict()))["checks"][0]["key"] == "findings"
 
 
+def test_a_contact_the_packages_srdf_disables_is_not_a_warning(tmp_path):
+    """As lint's P002: the pair the SRDF beside the robot disables (the Panda's three in example-robot-data)
+    is drawn red and named, but neither the pictures nor the collision matrix warn about it."""
+    robot = tmp_path / "touching.urdf"
+    robot.write_text(_arm(box="0.3 0.1 0.1"), encoding="utf-8")
+    (p002,) = [f for f in findings.findings(RobotAnalysis.load(robot)).findings if f.rule == "P002"]
+    a, b = p002.message.split("'")[1:4:2]
+    (tmp_path / "touching.srdf").write_text(
+        f'<robot name="touching"><disable_collisions link1="{a}" link2="{b}" reason="Default"/></robot>')
+    analysis = RobotAnalysis.load(robot, AnalysisSettings(samples=20, seed=1))
+    checks = {check.key: check for check in verdict.verdict(analysis).checks}
+    assert "P002" not in {f.rule for f in findings.findings(analysis).findings}
+    assert checks["renders"].status is verdict.Status.PASS
+    assert checks["renders"].line.endswith("1 pair in contact that the package's SRDF touching.srdf disables (drawn red)")
+    assert checks["collisions"].status is verdict.Status.PASS
+    assert "1 pair in contact at home that the package's SRDF touching.srdf disables" in checks["collisions"].line
+
+
 def test_xacro_findings_keep_their_lines_however_many_files_were_expanded_since(tmp_path):
     """An editor opens many xacro files and lints them later: each model keeps its elements' origins
     (only the last four expansions used to be known, then findings fell back to expanded-URDF lines)."""

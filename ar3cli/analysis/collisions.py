@@ -33,3 +33,26 @@ def collision_matrix(analysis: RobotAnalysis) -> CollisionMatrix:
     run = sample_matrix(model, settings.samples, settings.seed, None, ALWAYS_THRESHOLD)
     made = matrix_report(model, run, "text")
     return CollisionMatrix(run, made.data, made.lines)
+
+
+@question
+def moveit_disabled_pairs(analysis: RobotAnalysis) -> tuple[frozenset[frozenset[str]], str | None]:
+    """The link pairs MoveIt is told not to check (the settings' ``--srdf``, else the package's own SRDF) and
+    a note naming that SRDF: contact at home there is not a warning, as for lint-urdf's P002
+    (:func:`~ar3cli.urdf.srdf_read.moveit_disabled`)."""
+    from ar3cli.urdf.srdf_read import moveit_disabled
+
+    return moveit_disabled(analysis.require_model(), analysis.settings.srdf_disabled)
+
+
+def disabled_in_srdf(analysis: RobotAnalysis, pairs) -> tuple[list, str]:
+    """``pairs`` ((link a, link b), ...) MoveIt is told not to check, and the words naming where that is said
+    ('' when none is)."""
+    from ar3cli.urdf.srdf_read import is_disabled
+
+    disabled, note = moveit_disabled_pairs(analysis)
+    found = [pair for pair in pairs if is_disabled(disabled, *pair)]
+    if not found:
+        return [], ""
+    source = note.split(" (", 1)[0].removeprefix("pairs disabled by ") if note else "the --srdf SRDF"
+    return found, source

@@ -163,10 +163,13 @@ def lint_check(analysis: RobotAnalysis) -> Outcome:
 @check("renders", "pictures")
 def pictures_check(analysis: RobotAnalysis) -> Outcome:
     """Links drawn red (in contact at home) and visuals or pictures that could not be drawn."""
+    from ar3cli.analysis.collisions import disabled_in_srdf
     from ar3cli.analysis.pictures import pictures
 
     drawn = pictures(analysis)
     contacts = drawn.contacts_at_home()
+    allowed, source = disabled_in_srdf(analysis, list(contacts))
+    contacts = {pair: depth for pair, depth in contacts.items() if pair not in allowed}
     failed = [picture for picture in drawn.pictures if picture.error]
     left_out = {name for picture in drawn.pictures for name in picture.facts.get("visuals_not_drawn", [])}
     problems = []
@@ -178,9 +181,10 @@ def pictures_check(analysis: RobotAnalysis) -> Outcome:
         problems.append(f"{_count(len(failed), 'picture')} not drawn")
     if failed and len(failed) == len(drawn.pictures):
         return Outcome(Status.NOT_CHECKED, without_path(str(failed[0].error), analysis.path))
+    also = f"; {_count(len(allowed), 'pair')} in contact that {source} disables (drawn red)" if allowed else ""
     if not problems:
-        return Outcome(Status.PASS, "no two non-adjacent links in contact at home")
-    return Outcome(Status.WARNING, "; ".join(problems), len(contacts) + len(left_out) + len(failed))
+        return Outcome(Status.PASS, "no two non-adjacent links in contact at home" + also)
+    return Outcome(Status.WARNING, "; ".join(problems) + also, len(contacts) + len(left_out) + len(failed))
 
 
 MATRIX_WORDS = {"contact-at-home": "in contact at home",
@@ -191,17 +195,25 @@ MATRIX_WORDS = {"contact-at-home": "in contact at home",
 def collisions_check(analysis: RobotAnalysis) -> Outcome:
     """The collision matrix's warnings (contact at home, pairs PyBullet checks although they always
     touch, links without collision geometry); its info (contact only at a joint limit) is counted, not failed."""
-    from ar3cli.analysis.collisions import collision_matrix
+    from ar3cli.analysis.collisions import collision_matrix, disabled_in_srdf
+    from ar3cli.collisions.matrix import pair_label
     from ar3cli.findings import Severity
 
     matrix = collision_matrix(analysis)
-    warnings = [finding for finding in matrix.run.warnings if finding.severity >= Severity.WARNING]
-    infos = len(matrix.run.warnings) - len(warnings)
+    at_home = [(result.link_a, result.link_b) for result in matrix.run.results
+               if result.at_home and result.category != "adjacent"]
+    allowed, source = disabled_in_srdf(analysis, at_home)
+    labels = {pair_label(*pair) for pair in allowed}
+    warnings = [finding for finding in matrix.run.warnings if finding.severity >= Severity.WARNING
+                and not (finding.rule == "contact-at-home" and finding.message.split(" are ", 1)[0] in labels)]
+    infos = len([finding for finding in matrix.run.warnings if finding.severity < Severity.WARNING])
     kinds: dict[str, int] = {}
     for finding in warnings:
         kinds[finding.rule] = kinds.get(finding.rule, 0) + 1
     parts = [f"{_count(count, 'pair')} {MATRIX_WORDS[rule]}" for rule, count in kinds.items() if rule in MATRIX_WORDS]
     parts += [finding.message.split(":")[0] for finding in warnings if finding.rule not in MATRIX_WORDS]
+    if allowed:
+        parts.append(f"{_count(len(allowed), 'pair')} in contact at home that {source} disables")
     if infos:
         parts.append(f"{_count(infos, 'pair')} touching only at a joint limit (info)")
     counts = matrix.document.get("categories", {})

@@ -210,7 +210,7 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
     adjacent_direct = direct_parent_child(model)
     for result in results:
         key = frozenset((result.link_a, result.link_b))
-        label = f"{result.link_a} - {result.link_b}"
+        label = pair_label(result.link_a, result.link_b)
         if result.at_home and result.category != "adjacent":
             found.append(Finding("contact-at-home", Severity.WARNING,
                                  f"{label} are in contact at the home pose but not adjacent", path,
@@ -228,6 +228,11 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
                                  "would disable the pair)",
                                  path))
     return found
+
+
+def pair_label(link_a: str, link_b: str) -> str:
+    """``a - b``: how a finding names a link pair (its message starts with it)."""
+    return f"{link_a} - {link_b}"
 
 
 def _samples(result: PairResult) -> str:

@@ -63,20 +63,9 @@ class Context:
         user's ``--srdf``, else the SRDF the package ships for this robot
         (:func:`~ar3cli.urdf.srdf_read.package_srdf`), else none. P002 and M003 leave those pairs alone."""
         if "disabled-pairs" not in self._shared:
-            found: tuple[frozenset[frozenset[str]], str | None] = (self.srdf_disabled, None)
-            if not self.srdf_disabled:
-                from ar3cli.errors import UserError
-                from ar3cli.urdf.srdf_read import disabled_pairs, package_srdf
+            from ar3cli.urdf.srdf_read import moveit_disabled
 
-                path = package_srdf(self.model.path, self.model.name, {link.name for link in self.model.links})
-                if path is not None:
-                    try:
-                        pairs = disabled_pairs(path)
-                        found = (pairs, f"pairs disabled by the package's SRDF {path.name} (found beside the file "
-                                        "for this robot; --srdf FILE chooses another) are not reported")
-                    except UserError:
-                        pass
-            self._shared["disabled-pairs"] = found
+            self._shared["disabled-pairs"] = moveit_disabled(self.model, self.srdf_disabled)
         return self._shared["disabled-pairs"]
 
     def shared(self, key: str, build: Callable[[Model], T]) -> T:

@@ -181,3 +181,21 @@ def package_srdf(urdf_path: Path, robot_name: str | None, links: set[str]) -> Pa
             named = {link for entry in srdf.entries for link in (entry.link1, entry.link2)} | set(srdf.no_default)
             return path if named & links else None
     return None
+
+
+def moveit_disabled(model: Any, given: frozenset[frozenset[str]] = frozenset()) \
+        -> tuple[frozenset[frozenset[str]], str | None]:
+    """(the link pairs MoveIt is told not to check, a note saying where they come from or None): ``given``
+    (the user's ``--srdf``), else the SRDF the package ships for ``model`` (:func:`package_srdf`), else none.
+    lint's P002 and M003 and report's contact verdicts leave those pairs alone."""
+    if given:
+        return given, None
+    path = package_srdf(model.path, model.name, {link.name for link in model.links})
+    if path is None:
+        return frozenset(), None
+    try:
+        pairs = disabled_pairs(path)
+    except UserError:
+        return frozenset(), None
+    return pairs, (f"pairs disabled by the package's SRDF {path.name} (found beside the file for this robot; "
+                   "--srdf FILE chooses another) are not reported")
