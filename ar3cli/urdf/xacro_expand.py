@@ -234,7 +234,7 @@ def _expand_here(path: Path, args: dict[str, str], resolver: PackageResolver, po
                             "of memory") from None
         if isinstance(exc, RecursionError):
             raise UserError(f"{path}: xacro error: macro recursion too deep") from None
-        known = _arg_without_default(path, exc) or _package_uri_include(path, exc)
+        known = _arg_without_default(path, exc) or _package_uri_include(path, exc, resolver)
         if known:
             raise UserError(f"{path}: xacro error: {known}") from None
         raise UserError(f"{path}: xacro error: {_one_line(exc)}{_arguments_hint(path, args)}") from None
@@ -318,9 +318,10 @@ def _arg_without_default(path: Path, exc: BaseException) -> str:
 _INCLUDE_TAG = re.compile(r"<xacro:include\b[^>]*?\bfilename\s*=\s*[\"'](package://([^/\"']+)/?([^\"']*))[\"']")
 
 
-def _package_uri_include(path: Path, exc: BaseException) -> str:
+def _package_uri_include(path: Path, exc: BaseException, resolver: PackageResolver) -> str:
     """For an ``<xacro:include filename="package://...">`` (xacro reads it as a relative file name and
-    fails): where it is (file:line) and the spelling xacro resolves, ``$(find PKG)/...``; "" otherwise."""
+    fails): where it is (file:line) and the spelling xacro resolves, ``$(find PKG)/...``, saying so when that
+    file does not exist either (hector's include names a urdf/ folder its package does not have); "" otherwise."""
     from ar3cli.infra.safe_read import read_bytes
 
     inner = getattr(exc, "exc", None)
@@ -334,8 +335,10 @@ def _package_uri_include(path: Path, exc: BaseException) -> str:
     for match in _INCLUDE_TAG.finditer(text):
         if match.group(1) in str(inner.filename):
             line = text.count("\n", 0, match.start()) + 1
+            missing = "" if resolver.resolve(match.group(1)).found else " (no such file there either: check the path)"
             return (f"<xacro:include filename=\"{match.group(1)}\"> at {where}:{line}: xacro does not resolve package:// "
-                    f"in includes (it reads it as a relative file name); write $(find {match.group(2)})/{match.group(3)}")
+                    f"in includes (it reads it as a relative file name); write $(find {match.group(2)})/{match.group(3)}"
+                    f"{missing}")
     return ""
 
 
