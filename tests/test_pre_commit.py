@@ -6,7 +6,7 @@ import shutil
 
 import pytest
 
-from tests.conftest import ASSETS
+from tests.conftest import ASSETS, REPO
 from tests.hook_project import hook_project
 
 
@@ -24,3 +24,11 @@ def test_pre_commit_hook_blocks_broken_urdf_and_passes_good_one(tmp_path):
     shutil.copy(ASSETS / "ar3" / "ar3.urdf", project.folder / "arm.urdf")
     passed = project.commit("fixed arm")
     assert passed.returncode == 0, passed.stdout + passed.stderr
+
+
+def test_each_hook_runs_ar3cli_once_per_commit():
+    """pre-commit splits the files of a hook without require_serial into one batch per CPU: a commit of a
+    folder printed two summary lines (found on the newcomer walk). ar3cli shares files across CPUs itself."""
+    yaml = pytest.importorskip("yaml", reason="PyYAML comes with pre-commit (the test extra)")
+    hooks = yaml.safe_load((REPO / ".pre-commit-hooks.yaml").read_text())
+    assert hooks and all(hook.get("require_serial") is True for hook in hooks), hooks
