@@ -166,6 +166,13 @@ class Inertial:
     mass: float | None
     tensor: tuple[float, float, float, float, float, float] | None
     element: Any
+    parts: Mapping[Any, Any] = field(default_factory=dict, compare=False, repr=False)
+    """Each child tag -> the first child with it, read at load (:func:`_first_children`)."""
+
+    def first_child(self, tag: str) -> Any:
+        """``element.find(tag)`` without a search: the first ``<mass>``/``<inertia>``/``<origin>`` child, or None.
+        The inertia rules ask for it on every link (lxml's ``find`` costs ~2.5 µs a call)."""
+        return self.parts.get(tag) if self.parts else self.element.find(tag)
 
     def matrix(self) -> list[list[float]] | None:
         """The symmetric 3x3 tensor as nested lists, or None."""
@@ -230,6 +237,13 @@ class Joint:
     limit: Limit | None
     mimic: Mimic | None
     element: Any
+    parts: Mapping[Any, Any] = field(default_factory=dict, compare=False, repr=False)
+    """Each child tag -> the first child with it, read at load (:func:`_first_children`)."""
+
+    def first_child(self, tag: str) -> Any:
+        """``element.find(tag)`` without a search: the joint's first child ``tag`` (``<safety_controller>``,
+        ``<dynamics>``, ``<axis>``) or None. Rules ask for one on every joint (``find`` costs ~2.5 µs a call)."""
+        return self.parts.get(tag) if self.parts else self.element.find(tag)
 
     @property
     def line(self) -> int:
@@ -465,6 +479,7 @@ def _read_link(element, resolver: PackageResolver) -> Link:
             mass=parse_float(mass_element.get("value")) if mass_element is not None else None,
             tensor=tensor,
             element=inertial_element,
+            parts=parts,
         )
     return Link(
         name=element.get("name", ""),
@@ -541,6 +556,7 @@ def _read_joint(element) -> Joint:
         limit=limit,
         mimic=mimic,
         element=element,
+        parts=parts,
     )
 
 
