@@ -359,10 +359,10 @@ SINGLE_CHILDREN = {
       thresholds="Single children: " + "; ".join(f"<{parent}>: {', '.join(children)}"
                                                  for parent, children in SINGLE_CHILDREN.items()) + ".")
 def duplicate_element(ctx) -> Iterator[Hit]:
+    root = ctx.model.root
     for parent_tag, children in SINGLE_CHILDREN.items():
-        for parent in ctx.model.root.iter(parent_tag):
-            if parent_tag in ("joint", "link") and parent.getparent() is not ctx.model.root:
-                continue  # <joint> inside <transmission> or <ros2_control> is another element
+        # <joint> inside <transmission> or <ros2_control> is another element: only <robot>'s own count
+        for parent in (root.findall(parent_tag) if parent_tag in ("joint", "link") else root.iter(parent_tag)):
             tags = [tag for _child, tag in ctx.model.children(parent)]  # read at load for links and joints
             if len(set(tags)) == len(tags):
                 continue  # no tag twice (the common case): nothing to count
