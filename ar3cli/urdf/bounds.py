@@ -125,5 +125,8 @@ def link_bounds(link, shape_box=shape_bounds) -> Box | None:
 
 def box_union(boxes: Sequence[Box]) -> Box:
     """The box around ``boxes`` (at least one)."""
+    if len(boxes) == 1:  # most links have one shape of a kind: the box itself, as the general case gives it
+        low, high = boxes[0]
+        return tuple(low), tuple(high)
     lows, highs = zip(*boxes)
     return tuple(map(min, zip(*lows))), tuple(map(max, zip(*highs)))  # type: ignore[return-value]

@@ -200,7 +200,7 @@ def mass_not_positive(ctx) -> Iterator[Hit]:
         inertial = link.inertial
         if inertial is None or link.name not in moving:
             continue
-        mass_element = inertial.element.find("mass")
+        mass_element = inertial.first_child("mass")
         if mass_element is None or mass_element.get("value") is None:
             yield Hit(f"link '{link.name}' <inertial> has no <mass value=...>", inertial.element)
         elif inertial.mass is not None and not inertial.mass > 0:
@@ -235,7 +235,7 @@ def _tensor_hits(ctx, test):
 def inertia_not_positive_definite(ctx) -> Iterator[Hit]:
     for link, inertial, moments in _tensor_hits(ctx, lambda inertial, _m: is_positive_definite(inertial.matrix())):
         yield Hit(f"link '{link.name}' inertia is not positive definite: principal moments {_fmt(moments)}",
-                  inertial.element.find("inertia"))
+                  inertial.first_child("inertia"))
 
 
 @rule("I005", "inertia-triangle", "error", "Inertia violates the triangle inequality",
@@ -256,7 +256,7 @@ def inertia_triangle(ctx) -> Iterator[Hit]:
         a, b, c = moments
         tiny = " (the two smallest are below MuJoCo's mjMINVAL 1e-15: a line, not a body)" if b < MJ_MINVAL else ""
         yield Hit(f"link '{link.name}' principal moments {_fmt(moments)}: {a:.4g} + {b:.4g} < {c:.4g}{tiny}",
-                  inertial.element.find("inertia"))
+                  inertial.first_child("inertia"))
 
 
 def _zero_tensor_hits(ctx, in_inert_body: bool) -> Iterator[Hit]:
@@ -268,7 +268,7 @@ def _zero_tensor_hits(ctx, in_inert_body: bool) -> Iterator[Hit]:
         inertial = link.inertial
         if inertial is None or not (inertial.mass or 0) > 0:
             continue
-        element = inertial.element.find("inertia")
+        element = inertial.first_child("inertia")
         if element is None:
             if in_inert_body and link.name in moving:  # urdfdom refuses it too: on other links that is S019's
                 yield Hit(f"link '{link.name}' has mass {inertial.mass:g} kg but no <inertia>", inertial.element)
@@ -398,7 +398,7 @@ def inertia_near_singular(ctx) -> Iterator[Hit]:
         why = (f"below MuJoCo's mjMINVAL {MJ_MINVAL:g}: MuJoCo refuses the body" if smallest < MJ_MINVAL else
                f"{smallest / largest:.1e} of the largest: no real body is that thin")
         yield Hit(f"link '{link.name}' principal moments {_fmt(moments)}: the smallest is {why}",
-                  inertial.element.find("inertia"))
+                  inertial.first_child("inertia"))
 
 
 @rule("I007", "inertia-implausible", "warning", "Inertia implausible for the link's geometry",
@@ -431,7 +431,7 @@ def inertia_implausible(ctx) -> Iterator[Hit]:
         looks = (f": the tensor looks like {unit[0]} (I_max {largest / unit[1]:.3g} kg·m²?)" if unit is not None else "")
         yield Hit(f"link '{link.name}' radius of gyration {gyration:.3g} m is {ratio:.0f}x "
                   f"its geometry's half-diagonal {half_diagonal:.3g} m (mass {link.inertial.mass:g} kg, "
-                  f"I_max {largest:.3g} kg·m²){looks}", link.inertial.element.find("inertia"),
+                  f"I_max {largest:.3g} kg·m²){looks}", link.inertial.first_child("inertia"),
                   hint=(f"Divide every inertia entry by {unit[1]:.0e} (kg·m²), or recompute it: ar3cli fix-inertia "
                         "rescales it." if unit is not None else None))
 
@@ -548,7 +548,7 @@ def mass_zero_with_inertia(ctx) -> Iterator[Hit]:
         effect = ("PyBullet adds nothing to the parent" if ctx.model.parent_joint(link.name) is not None
                   else "a static body in PyBullet")
         yield Hit(f"link '{link.name}' has mass 0 but inertia {_fmt(tensor_moments(inertial.tensor))}: {effect}, "
-                  "a 1 kg sphere in Drake", inertial.element.find("mass"))
+                  "a 1 kg sphere in Drake", inertial.first_child("mass"))
 
 
 @rule("I011", "world-inertial", "warning", "<inertial> on the link named 'world'",

@@ -302,7 +302,7 @@ def effort_velocity_zero(ctx) -> Iterator[Hit]:
 def axis_zero(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         if joint.type in ACTUATED_TYPES and joint.axis_given and all(c == 0 for c in joint.axis):
-            yield Hit(f"joint '{joint.name}' axis is 0 0 0", joint.element.find("axis"))
+            yield Hit(f"joint '{joint.name}' axis is 0 0 0", joint.first_child("axis"))
 
 
 @rule("J010", "axis-not-unit", "warning", "Joint axis is not a unit vector",
@@ -320,7 +320,7 @@ def axis_not_unit(ctx) -> Iterator[Hit]:
         norm = math.sqrt(sum(c * c for c in joint.axis))
         if norm > 0 and math.isfinite(norm) and abs(norm - 1.0) > 1e-3:
             unit = " ".join(f"{c / norm:.6g}" for c in joint.axis)
-            yield Hit(f"joint '{joint.name}' axis has length {norm:.4g}", joint.element.find("axis"),
+            yield Hit(f"joint '{joint.name}' axis has length {norm:.4g}", joint.first_child("axis"),
                       hint=f'Use <axis xyz="{unit}"/>.')
 
 

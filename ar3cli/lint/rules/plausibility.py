@@ -216,7 +216,7 @@ def density_implausible(ctx) -> Iterator[Hit]:
 
 def _mass_element(link):
     """The link's ``<mass>`` element (where a density finding points), or None."""
-    return link.inertial.element.find("mass") if link.inertial is not None else None
+    return link.inertial.first_child("mass") if link.inertial is not None else None
 
 
 @rule("I014", "mass-tiny", "warning", "Moving link lighter than a gram",
@@ -239,7 +239,7 @@ def mass_tiny(ctx) -> Iterator[Hit]:
         mass = link.inertial.mass if link.inertial is not None else None
         if link.name in moving and mass is not None and mass > 0 and 0 < carried[link.name] < MIN_MASS:
             yield Hit(f"link '{link.name}' moves (joint '{moving[link.name].name}') and weighs {carried[link.name]:g} kg "
-                      "with everything below it", link.inertial.element.find("mass"))
+                      "with everything below it", link.inertial.first_child("mass"))
 
 
 @rule("I015", "mass-ratio", "warning", "Masses across a joint differ more than solvers handle",

@@ -131,26 +131,29 @@ class SchemaWalk:
     odd: tuple[Node, ...]
 
 
-def _children(element) -> list[tuple[Any, Any]]:
-    return [(child, child.tag) for child in element] if len(element) else []  # most are leaves: <origin/>
-
-
-def _urdf_nodes(root) -> SchemaWalk:
+def _urdf_nodes(model) -> SchemaWalk:
     """Every element inside the robot's URDF part: <link>, <joint> and <material> children of <robot>
     and, below them, only children the schema knows (so an extension's subtree is never walked);
-    each with its children, read once for every schema rule. Depth first, the last child first."""
+    each with its children (:meth:`~ar3cli.urdf.model.Model.children`: those the load read are not read
+    again), read once for every schema rule. Depth first, the last child first."""
     # ``tag in names`` is ``_local(tag) in names``: the schema's names are plain, and a comment's tag
     # (a function) or a namespaced tag ("{uri}origin") is none of them.
     nodes: list[Node] = []
     odd: list[Node] = []
-    stack = [(child, tag) for child in root if (tag := child.tag) in SCHEMA["robot"][1]]
+    stack = [(child, tag) for child, tag in model.children(model.root) if tag in SCHEMA["robot"][1]]
+    read = model.read_children
     while stack:
         element, tag = stack.pop()
-        if not len(element):  # a leaf (<origin/>, <mass/>): most elements
-            nodes.append((element, tag, []))
-            continue
-        node = (element, tag, _children(element))
+        children = read.get(element)
+        if children is None:  # not a link, joint or one of their containers: read here
+            if not len(element):  # a leaf (<origin/>, <mass/>): most elements
+                nodes.append((element, tag, []))
+                continue
+            children = [(child, child.tag) for child in element]
+        node = (element, tag, children)
         nodes.append(node)
+        if not children:
+            continue
         names = SCHEMA[tag][1]
         known = [pair for pair in node[2] if pair[1] in names]
         if len(known) != len(node[2]):
@@ -162,7 +165,7 @@ def _urdf_nodes(root) -> SchemaWalk:
 
 def _schema_walk(ctx) -> SchemaWalk:
     """:func:`_urdf_nodes` of the file, walked once for all the schema rules."""
-    return ctx.shared("schema-walk", lambda model: _urdf_nodes(model.root))
+    return ctx.shared("schema-walk", _urdf_nodes)
 
 
 def owner(element) -> str:
@@ -180,7 +183,7 @@ def owner(element) -> str:
 def _unknown_children(ctx) -> Iterator[tuple]:
     """(element, unknown child, closest allowed name or None) for every child the schema lacks."""
     root = ctx.model.root
-    for element, element_tag, element_children in ((root, root.tag, _children(root)), *_schema_walk(ctx).odd):
+    for element, element_tag, element_children in ((root, root.tag, ctx.model.children(root)), *_schema_walk(ctx).odd):
         attrs, children = SCHEMA[element_tag]
         if element_tag in GEOMETRY_SHAPES_OWNED_ELSEWHERE:
             continue

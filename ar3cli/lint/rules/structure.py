@@ -359,11 +359,11 @@ SINGLE_CHILDREN = {
       thresholds="Single children: " + "; ".join(f"<{parent}>: {', '.join(children)}"
                                                  for parent, children in SINGLE_CHILDREN.items()) + ".")
 def duplicate_element(ctx) -> Iterator[Hit]:
+    root = ctx.model.root
     for parent_tag, children in SINGLE_CHILDREN.items():
-        for parent in ctx.model.root.iter(parent_tag):
-            if parent_tag in ("joint", "link") and parent.getparent() is not ctx.model.root:
-                continue  # <joint> inside <transmission> or <ros2_control> is another element
-            tags = [child.tag for child in parent]
+        # <joint> inside <transmission> or <ros2_control> is another element: only <robot>'s own count
+        for parent in (root.findall(parent_tag) if parent_tag in ("joint", "link") else root.iter(parent_tag)):
+            tags = [tag for _child, tag in ctx.model.children(parent)]  # read at load for links and joints
             if len(set(tags)) == len(tags):
                 continue  # no tag twice (the common case): nothing to count
             counts = Counter(tag for tag in tags if isinstance(tag, str))
@@ -374,7 +374,7 @@ def duplicate_element(ctx) -> Iterator[Hit]:
                     yield Hit(f"{owner} has {counts[tag]} <{tag}> elements: every parser reads the first and ignores "
                               "the rest", extra)
     for geometry in ctx.model.root.iter("geometry"):
-        shapes = [child for child in geometry if isinstance(child.tag, str)]
+        shapes = [child for child, tag in ctx.model.children(geometry) if isinstance(tag, str)]
         if len(shapes) > 1:
             yield Hit(f"{_owner_name(geometry)} has {len(shapes)} children ({listed(child.tag for child in shapes)}): "
                       "parsers read the first as the shape and ignore the rest", shapes[1])

@@ -210,10 +210,10 @@ def drake_ignores(ctx) -> Iterator[Hit]:
 
     for joint in ctx.model.joints:
         for tag in DRAKE_IGNORED_ELEMENTS:
-            element = joint.element.find(tag)
+            element = joint.first_child(tag)
             if element is not None:
                 yield Hit(f"joint '{joint.name}' <{tag}>: Drake ignores it", element)
-        dynamics = joint.element.find("dynamics")
+        dynamics = joint.first_child("dynamics")
         friction = parse_float(dynamics.get("friction")) if dynamics is not None else None
         if friction:
             yield Hit(f"joint '{joint.name}' <dynamics friction=\"{dynamics.get('friction')}\">: Drake has no joint "

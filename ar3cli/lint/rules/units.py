@@ -165,7 +165,7 @@ def _soft_robot(soft: str) -> str:
 def soft_limits_outside(ctx) -> Iterator[Hit]:
     for joint in ctx.model.joints:
         limit = joint.limit
-        safety = joint.element.find("safety_controller")
+        safety = joint.first_child("safety_controller")
         if safety is None or limit is None or joint.type not in ("revolute", "prismatic") \
                 or limit.lower is None or limit.upper is None or not limit.lower <= limit.upper:
             continue
