@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 from pathlib import Path
 
 import pytest
@@ -12,7 +13,8 @@ from lxml import etree
 
 from ar3cli.collisions import srdf_files
 from ar3cli.collisions.matrix import PairResult
-from ar3cli.urdf.srdf_read import GENERATED_REASONS, read_srdf
+from ar3cli.urdf.model import load_model
+from ar3cli.urdf.srdf_read import GENERATED_REASONS, disabled_pairs, moveit_disabled, read_srdf
 from tests.conftest import ASSETS, REPO
 
 FIXTURE = REPO / "tests" / "data" / "srdf" / "ar3.srdf"
@@ -201,6 +203,21 @@ def test_moveit_semantics_of_enable_and_default_entries(tmp_path):
     assert existing.disabled_by("a", "c") == "default off"  # a's default entry
     assert existing.disabled_by("b", "a") is None  # the explicit enable beats the default
     assert existing.disabled_by("c", "d") == "disabled"  # an explicit disable wins, as in MoveIt
+    pairs = disabled_pairs(path)  # what P002, M003 and report leave alone: the same answers
+    assert pairs.covers("a", "c") and not pairs.covers("b", "a") and pairs.covers("d", "c")
+    assert not pairs.covers("b", "c")
+
+
+def test_an_srdf_given_that_disables_nothing_is_not_replaced_by_the_packages(tmp_path):
+    """--srdf FILE with no disabled pair used to fall back to the package's own SRDF (an empty set is false)."""
+    package = tmp_path / "pkg"
+    shutil.copytree(REPO / "tests" / "data" / "quiet" / "srdf_package", package)
+    model = load_model(package / "urdf" / "arm.urdf")
+    own, note = moveit_disabled(model)
+    assert own.explicit and "arm.srdf" in note
+    (tmp_path / "mine.srdf").write_text('<robot name="arm"><group name="g"/></robot>')
+    given = disabled_pairs(tmp_path / "mine.srdf")
+    assert moveit_disabled(model, given) == (given, None)
 
 
 # ---- the real panda SRDF of example-robot-data, on pybullet_data's panda --------------------------------

@@ -10,6 +10,7 @@ from ar3cli.analysis.robot import RobotAnalysis, question
 
 if TYPE_CHECKING:
     from ar3cli.collisions.run import MatrixRun
+    from ar3cli.urdf.srdf_read import DisabledPairs
 
 
 @dataclass(frozen=True)
@@ -36,7 +37,7 @@ def collision_matrix(analysis: RobotAnalysis) -> CollisionMatrix:
 
 
 @question
-def moveit_disabled_pairs(analysis: RobotAnalysis) -> tuple[frozenset[frozenset[str]], str | None]:
+def moveit_disabled_pairs(analysis: RobotAnalysis) -> tuple[DisabledPairs, str | None]:
     """The link pairs MoveIt is told not to check (the settings' ``--srdf``, else the package's own SRDF) and
     a note naming that SRDF: contact at home there is not a warning, as for lint-urdf's P002
     (:func:`~ar3cli.urdf.srdf_read.moveit_disabled`)."""

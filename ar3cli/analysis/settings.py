@@ -21,6 +21,7 @@ from ar3cli.lint.config import LintConfig
 
 if TYPE_CHECKING:
     from ar3cli.lint.engine import LintOptions
+    from ar3cli.urdf.srdf_read import DisabledPairs
 
 DEFAULT_SAMPLES = 100
 """Random configurations of the simulated sections (collision matrix, torques, FK, cross-check):
@@ -43,7 +44,7 @@ class AnalysisSettings:
     config: LintConfig = field(default_factory=LintConfig)
     targets: tuple[str, ...] | None = None
     """None: lint's default targets (pybullet and ros)."""
-    srdf_disabled: frozenset[frozenset[str]] = frozenset()
+    srdf_disabled: DisabledPairs | None = None
     samples: int = DEFAULT_SAMPLES
     seed: int = 0
 

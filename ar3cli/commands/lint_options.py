@@ -5,13 +5,16 @@ from __future__ import annotations
 
 import enum
 from pathlib import Path
-from typing import Annotated, Any, Optional
+from typing import TYPE_CHECKING, Annotated, Any, Optional
 
 import typer
 
 from ar3cli.commands.options import format_option
 from ar3cli.errors import UserError
 from ar3cli.output.formats import LINT
+
+if TYPE_CHECKING:
+    from ar3cli.urdf.srdf_read import DisabledPairs
 
 
 class Engine(str, enum.Enum):
@@ -136,10 +139,11 @@ def parse_targets(values: list[str] | None) -> tuple[str, ...]:
     return names
 
 
-def srdf_disabled(srdf: Path | None, sim: bool) -> frozenset[frozenset[str]]:
-    """The pairs ``--srdf`` disables; it only matters with ``--sim`` (a one-line error without)."""
+def srdf_disabled(srdf: Path | None, sim: bool) -> DisabledPairs | None:
+    """The pairs ``--srdf`` disables (None: no ``--srdf``); it only matters with ``--sim`` (a one-line error
+    without)."""
     if srdf is None:
-        return frozenset()
+        return None
     if not sim:
         raise UserError("--srdf only changes the --sim checks (P002, contact at the home pose): add --sim")
     from ar3cli.urdf.srdf_read import disabled_pairs

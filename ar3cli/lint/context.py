@@ -5,11 +5,14 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, TypeVar
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from ar3cli.maths.tensor_math import symmetric_eigenvalues
 from ar3cli.urdf.bounds import Box, box_around, box_union, link_bounds, scaled_mesh_bounds, shape_bounds
 from ar3cli.urdf.model import Link, Model, Shape
+
+if TYPE_CHECKING:
+    from ar3cli.urdf.srdf_read import DisabledPairs
 
 T = TypeVar("T")
 Matrix = tuple[tuple[float, float, float], ...]
@@ -44,11 +47,11 @@ class Context:
     """The model a rule checks, with the link boxes and the PyBullet session built once per file
     and shared by every rule that asks (pybullet is imported only when a ``--sim`` rule does)."""
 
-    def __init__(self, model: Model, srdf_disabled: frozenset[frozenset[str]] = frozenset(),
+    def __init__(self, model: Model, srdf_disabled: DisabledPairs | None = None,
                  targets: tuple[str, ...] = ("pybullet", "ros")) -> None:
         self.model = model
         self.srdf_disabled = srdf_disabled
-        """Pairs the user's SRDF disables (``lint-urdf --srdf``; see :func:`ar3cli.urdf.srdf_read.is_disabled`)."""
+        """Pairs the user's SRDF disables (``lint-urdf --srdf``), None when none was given."""
         self.targets = targets
         """The engines the robot is meant for (``lint-urdf --target``): a rule whose verdict depends on
         the engine (a mesh MuJoCo finds through its own ``meshdir``) asks here."""
@@ -58,7 +61,7 @@ class Context:
         self._session: Any = None
         self._shared: dict[str, Any] = {}
 
-    def disabled_pairs(self) -> tuple[frozenset[frozenset[str]], str | None]:
+    def disabled_pairs(self) -> tuple[DisabledPairs, str | None]:
         """(the link pairs MoveIt is told not to check, a note saying where they come from or None): the
         user's ``--srdf``, else the SRDF the package ships for this robot
         (:func:`~ar3cli.urdf.srdf_read.package_srdf`), else none. P002 and M003 leave those pairs alone."""

@@ -31,6 +31,7 @@ from ar3cli.lint.rules.file import LIBRARY
 
 if TYPE_CHECKING:
     from ar3cli.lint.result_cache import ResultCache
+    from ar3cli.urdf.srdf_read import DisabledPairs
 
 ROBOT_SUFFIXES = (".urdf", ".xacro")
 ENGINE_OF = {"P": "pybullet", "M": "mujoco"}
@@ -51,8 +52,9 @@ class LintOptions:
     sim: bool = False
     package_paths: Mapping[str, Path] = field(default_factory=dict)
     xacro_args: Mapping[str, str] = field(default_factory=dict)
-    srdf_disabled: frozenset[frozenset[str]] = frozenset()
-    """Link pairs an SRDF tells MoveIt not to check (``--srdf``): not reported as colliding at home."""
+    srdf_disabled: DisabledPairs | None = None
+    """Link pairs an SRDF tells MoveIt not to check (``--srdf``): not reported as colliding at home. None: no
+    ``--srdf``, the package's own SRDF is looked for."""
     engines: tuple[str, ...] = ("pybullet",)
     """Simulators ``--sim`` runs (``--engine``): P rules need ``pybullet``, M rules ``mujoco`` (or their code named)."""
     targets: tuple[str, ...] = ("pybullet", "ros")

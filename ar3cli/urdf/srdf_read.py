@@ -118,20 +118,35 @@ def read_srdf(path: Path) -> Srdf:
     return srdf
 
 
-def disabled_pairs(path: Path) -> frozenset[frozenset[str]]:
-    """Every link pair the SRDF at ``path`` tells MoveIt not to check (explicit disables, and pairs
-    with a ``disable_default_collisions`` link that no ``enable_collisions`` turns back on), as
-    MoveIt reads it. Default-off links make every pair with them disabled: returned as ``{link}``
-    sets of one, which callers test with :func:`is_disabled`."""
+@dataclass(frozen=True)
+class DisabledPairs:
+    """The link pairs an SRDF tells MoveIt not to check, as MoveIt builds its allowed-collision matrix (and
+    :meth:`Srdf.disabled_by`): an explicit ``<disable_collisions>`` wins, then an explicit
+    ``<enable_collisions>``, then a link's ``<disable_default_collisions>``."""
+
+    explicit: frozenset[frozenset[str]] = frozenset()
+    enabled: frozenset[frozenset[str]] = frozenset()
+    default_off: frozenset[str] = frozenset()
+
+    def covers(self, a: str, b: str) -> bool:
+        """Whether MoveIt leaves the pair (a, b) unchecked."""
+        key = frozenset((a, b))
+        if key in self.explicit:
+            return True
+        return key not in self.enabled and (a in self.default_off or b in self.default_off)
+
+
+def disabled_pairs(path: Path) -> DisabledPairs:
+    """Every link pair the SRDF at ``path`` tells MoveIt not to check (:class:`DisabledPairs`)."""
     srdf = read_srdf(path)
-    pairs = {entry.key for entry in srdf.entries if entry.kind == "disable"}
-    pairs |= {frozenset((link,)) for link in srdf.no_default}
-    return frozenset(pairs)
+    return DisabledPairs(frozenset(entry.key for entry in srdf.entries if entry.kind == "disable"),
+                         frozenset(entry.key for entry in srdf.entries if entry.kind == "enable"),
+                         frozenset(srdf.no_default))
 
 
-def is_disabled(pairs: frozenset[frozenset[str]], a: str, b: str) -> bool:
-    """Whether ``disabled_pairs`` covers the pair (a, b)."""
-    return frozenset((a, b)) in pairs or frozenset((a,)) in pairs or frozenset((b,)) in pairs
+def is_disabled(pairs: DisabledPairs, a: str, b: str) -> bool:
+    """Whether ``pairs`` (:func:`disabled_pairs`) covers the pair (a, b)."""
+    return pairs.covers(a, b)
 
 
 PACKAGE_FOLDERS = ("urdf", "robots")
@@ -183,19 +198,19 @@ def package_srdf(urdf_path: Path, robot_name: str | None, links: set[str]) -> Pa
     return None
 
 
-def moveit_disabled(model: Any, given: frozenset[frozenset[str]] = frozenset()) \
-        -> tuple[frozenset[frozenset[str]], str | None]:
+def moveit_disabled(model: Any, given: DisabledPairs | None = None) -> tuple[DisabledPairs, str | None]:
     """(the link pairs MoveIt is told not to check, a note saying where they come from or None): ``given``
-    (the user's ``--srdf``), else the SRDF the package ships for ``model`` (:func:`package_srdf`), else none.
-    lint's P002 and M003 and report's contact verdicts leave those pairs alone."""
-    if given:
+    (the user's ``--srdf``, even one that disables nothing), else the SRDF the package ships for ``model``
+    (:func:`package_srdf`), else none. lint's P002 and M003 and report's contact verdicts leave those pairs
+    alone."""
+    if given is not None:
         return given, None
     path = package_srdf(model.path, model.name, {link.name for link in model.links})
     if path is None:
-        return frozenset(), None
+        return DisabledPairs(), None
     try:
         pairs = disabled_pairs(path)
     except UserError:
-        return frozenset(), None
+        return DisabledPairs(), None
     return pairs, (f"pairs disabled by the package's SRDF {path.name} (found beside the file for this robot; "
                    "--srdf FILE chooses another) are not reported")
