@@ -175,6 +175,25 @@ def test_libraries_and_include_bodies_are_one_info_line_and_entry_failures_stay_
     assert found["robot.urdf.xacro"] == []
 
 
+def test_a_broken_robot_stays_an_error_whatever_includes_it(tmp_path):
+    """A fragment is an info only where a file that includes it expands: a broken robot that another file
+    includes (a *_gazebo wrapper), or one whose name a working file includes from elsewhere, stayed a
+    passing F008 when pre-commit linted it alone (found in review)."""
+    xacro = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    (tmp_path / "robot.urdf.xacro").write_text(
+        f'<robot name="r" {xacro}><link name="base"><inertial><mass value="${{undefined_mass}}"/>'
+        '<inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link></robot>')
+    (tmp_path / "robot_gazebo.urdf.xacro").write_text(
+        f'<robot name="r" {xacro}><xacro:include filename="robot.urdf.xacro"/></robot>')
+    (tmp_path / "other").mkdir()
+    (tmp_path / "other" / "robot.urdf.xacro").write_text(f'<robot {xacro}><link name="x"/></robot>')
+    (tmp_path / "decoy.urdf.xacro").write_text(
+        f'<robot name="d" {xacro}><xacro:include filename="other/robot.urdf.xacro"/></robot>')
+    options = LintOptions(select=["ALL"])
+    (finding,) = lint_file(tmp_path / "robot.urdf.xacro", options.rules(), options).findings
+    assert finding.rule == "F004" and finding.severity is Severity.ERROR, finding.message
+
+
 @pytest.mark.slow
 def test_a_macro_library_is_one_info_line_with_the_pybullet_rules_too():
     found = _by_file("fragments", sim=True)

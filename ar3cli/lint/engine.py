@@ -392,7 +392,7 @@ def lint_file(path: Path, rules: list[Rule], options: LintOptions, cache: Result
             data = read_bytes(path)
         model = load_model(path, options.package_paths, options.xacro_args, source=data)
     except UserError as exc:
-        finding = included_failure(path, load_failure(path, shown, exc.message))
+        finding = included_failure(path, load_failure(path, shown, exc.message), options)
     except RecursionError:
         finding = Finding("F002", Severity.ERROR, "document nested too deeply to parse", shown)
     except MemoryError:
@@ -547,21 +547,37 @@ def internal_error(where: str, exc: BaseException) -> str:
     return f"internal error {where} ({type(exc).__name__}{': ' + text if text else ''}), please report it"
 
 
-def included_failure(path: Path, failure: Finding) -> Finding:
-    """``failure``, or F008 at info when it is an F004 of a xacro library or of a fragment a file of its
-    package includes (:func:`~ar3cli.lint.rules.file.fragment_message`): the includer reports it."""
+def included_failure(path: Path, failure: Finding, options: LintOptions) -> Finding:
+    """``failure``, or F008 at info when it is an F004 of a xacro library, or of a fragment that a file of its
+    package includes and that expands there (:func:`~ar3cli.lint.rules.file.fragment_message`): the includer
+    reports it."""
     from ar3cli.infra.safe_read import read_bytes
     from ar3cli.lint.rules.file import fragment_message
 
     if failure.rule != "F004":
         return failure
     try:
-        message = fragment_message(path, read_bytes(path), failure.message)
+        message = fragment_message(path, read_bytes(path), failure.message,
+                                   lambda includer: _expands_including(includer, path, options))
     except UserError:
         return failure
     if message is None:
         return failure
     return Finding(LIBRARY, REGISTRY[LIBRARY].severity, message, failure.path, 0, 0, REGISTRY[LIBRARY].fix)
+
+
+def _expands_including(includer: Path, path: Path, options: LintOptions) -> bool:
+    """Whether ``includer`` expands (with the run's packages and xacro arguments) and what it included is the
+    file ``path`` (not another of the same name)."""
+    from ar3cli.urdf.model import load_model
+
+    try:
+        model = load_model(includer, options.package_paths, options.xacro_args)
+    except UserError:
+        return False
+    included = model.expansion.included if model.expansion is not None else []
+    own = path.resolve()
+    return any(Path(name).resolve() == own for name in included)
 
 
 def load_failure(path: Path, shown: str, message: str) -> Finding:

@@ -120,10 +120,10 @@ def library_in_root(root, path: Path, find_includers: bool = True) -> MacroLibra
     if not macros and not counts["property"] and not counts["material"]:
         return None
     return MacroLibrary(tuple(sorted(macros)), counts["property"], counts["material"],
-                        includers(path) if find_includers else ())
+                        shown_files(includers(path), path.parent) if find_includers else ())
 
 
-def includers(path: Path) -> tuple[str, ...]:
+def includers(path: Path) -> tuple[Path, ...]:
     """The robot files that include a file of ``path``'s name, looked for in its package (the nearest
     folder with a package.xml, at most MAX_LEVELS above) or, outside a package, in its own folder tree:
     where ar3cli may read anyway (docs/security.md). A hint, so the search is bounded (MAX_FOLDERS
@@ -140,7 +140,7 @@ def includers(path: Path) -> tuple[str, ...]:
     else:
         top = own.parent
     name = own.name.encode()
-    found: list[str] = []
+    found: list[Path] = []
     folders = files_seen = 0
     for current, dirs, files in os.walk(top):
         folders += 1
@@ -155,8 +155,7 @@ def includers(path: Path) -> tuple[str, ...]:
             except UserError:
                 continue
             if _includes_name(text, name):
-                relative = os.path.relpath(candidate)
-                found.append(str(candidate) if relative.startswith("..") else relative)
+                found.append(candidate)
             if len(found) >= 3 or files_seen >= MAX_CANDIDATES:
                 return tuple(found)
         if folders >= MAX_FOLDERS:
@@ -173,3 +172,23 @@ def _includes_name(text: bytes, name: bytes) -> bool:
         if last == name or (b"*" in last or b"?" in last or b"[" in last) and fnmatch.fnmatchcase(name, last):
             return True
     return False
+
+
+def shown_files(paths, folder: Path) -> tuple[str, ...]:
+    """``paths`` as a message may show them: relative to the current folder when inside it, else to the robot's
+    ``folder`` when inside that; the others only counted ("2 files outside the robot's folder"), as
+    :func:`~ar3cli.urdf.packages.shown_places` does for searched places (docs/security.md)."""
+    here, own = Path.cwd().resolve(), folder.resolve()
+    shown: list[str] = []
+    hidden = 0
+    for path in paths:
+        full = Path(path).resolve()
+        if full.is_relative_to(here):
+            shown.append(str(full.relative_to(here)))
+        elif full.is_relative_to(own):
+            shown.append(str(full.relative_to(own)))
+        else:
+            hidden += 1
+    if hidden:
+        shown.append(f"{hidden} file{'s' if hidden != 1 else ''} outside the robot's folder")
+    return tuple(shown)

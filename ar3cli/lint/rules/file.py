@@ -4,8 +4,9 @@ from __future__ import annotations
 
 import math
 import re
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from functools import lru_cache
+from pathlib import Path
 
 from ar3cli.lint.rules.base import Hit, engine_rule, robot, rule
 
@@ -226,28 +227,31 @@ def _includer_text(included_by) -> str:
     return f"included by {', '.join(included_by)}" if included_by else "no file of its package was found to include it"
 
 
-def fragment_message(path, source: bytes, reason: str) -> str | None:
+def fragment_message(path, source: bytes, reason: str, expands_including: Callable[[Path], bool]) -> str | None:
     """F008's message for a xacro file whose expansion failed with ``reason`` (an F004) when it is a library,
-    or a fragment: it reads a ``$(arg NAME)`` it does not declare (an include body, which reads its includer's
-    arguments: xacro's arguments are global), or a file of its package includes it. Its includer reports the
-    failure (xacro stops there too), so the file itself gets one info line instead of an error. None for an
-    entry file: its F004 stands."""
-    from ar3cli.urdf.macro_library import includers, library_in_source
+    or a fragment that a file of its package includes and that expands there (``expands_including(includer)``:
+    the includer expands, and what it included is this file). A fragment reads its includer's properties, or
+    a ``$(arg NAME)`` it does not declare (xacro's arguments are global). Its includer checks it, so the
+    file itself gets one info line instead of an error. None for an entry file, and for a fragment no
+    working includer vouches for: its F004 stands (a pull request cannot silence a broken robot by adding
+    a file that includes it, nor by an includer pre-commit does not lint)."""
+    from ar3cli.urdf.macro_library import includers, library_in_source, shown_files
 
     library = library_in_source(source, path)
     if library is not None:
         return (f"{library.describe()} and instantiates no robot: a xacro library, checked where an entry file "
                 f"includes it ({_includer_text(library.included_by)}); alone it does not expand: {reason}")
+    working = [includer for includer in includers(path) if expands_including(includer)]
+    if not working:
+        return None
+    where = ", ".join(shown_files(working, Path(path).parent))
     missing = _UNDEFINED_ARG.search(reason)
     if missing is not None and missing.group(1) in _undeclared_args(source):
         return (f"a xacro fragment: it reads $(arg {missing.group(1)}) without declaring it (<xacro:arg>), as an "
-                "include body reads its includer's arguments; it is checked where that file includes it, and does "
-                "not expand alone")
-    found = includers(path)
-    if not found:
-        return None
-    return (f"a xacro fragment included by {', '.join(found)}, where it is checked: alone it does not expand "
-            f"({reason})")
+                f"include body reads its includer's arguments; it is checked where {where} includes it (that "
+                "file expands), and does not expand alone")
+    return (f"a xacro fragment included by {where}, where it is checked (that file expands): alone it does not "
+            f"expand ({reason})")
 
 
 _UNDEFINED_ARG = re.compile(r"Undefined substitution argument ([\w.-]+)")
