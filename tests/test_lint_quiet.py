@@ -253,8 +253,33 @@ def test_a_macros_finding_is_reported_once_for_every_robot_that_includes_it(jobs
     results = lint_paths([DATA / "shared_macro"], options, use_cache=False, jobs=jobs)
     found = [f for r in results for f in r.findings if f.rule == "G008"]
     (finding,) = found
-    assert finding.path.endswith("parts.xacro") and "found through 3 linted files" in finding.message
+    assert finding.path.endswith("parts.xacro") and "Found through 3 linted files" in finding.hint
     assert "robot_b.urdf.xacro" in finding.hint and "robot_c.urdf.xacro" in finding.hint
+    assert "found through" not in finding.message  # a baseline of the folder matches a run on one file
+
+
+def test_merged_repeats_count_once_and_a_macro_called_twice_stays_two_findings(tmp_path):
+    """Review: two calls of one broken macro in one robot became one finding 'found through 2 linted files'
+    naming the robot itself; a severity override counted every dropped copy as 'made less severe'."""
+    from ar3cli.findings import Severity as S
+    from ar3cli.lint.engine import lint_paths
+
+    xacro = 'xmlns:xacro="http://www.ros.org/wiki/xacro"'
+    (tmp_path / "hand.xacro").write_text(
+        f'<robot {xacro}>\n<xacro:macro name="hand" params="prefix">\n'
+        f'<link name="${{prefix}}hand"><visual>\n<origin xyz="0 0"/>\n'
+        '<geometry><box size="0.1 0.1 0.1"/></geometry></visual></link>\n</xacro:macro>\n</robot>\n')
+    for name in ("a", "b"):
+        (tmp_path / f"robot_{name}.urdf.xacro").write_text(
+            f'<robot name="{name}" {xacro}><xacro:include filename="hand.xacro"/>'
+            '<xacro:hand prefix="l_"/><xacro:hand prefix="r_"/></robot>')
+    options = LintOptions(select=["F007"], severity={"F007": S.WARNING})
+    results = lint_paths([tmp_path], options, use_cache=False, jobs=1)
+    by_file = {Path(r.path).name: r for r in results}
+    own = by_file["robot_a.urdf.xacro"].findings
+    assert len(own) == 2 and all("Found through 2 linted files" in f.hint for f in own)
+    assert by_file["robot_b.urdf.xacro"].findings == []
+    assert sum(r.lowered for r in results) == 2
 
 
 def test_a_zero_size_collision_is_found_at_the_shape_and_is_an_error_for_mujoco():

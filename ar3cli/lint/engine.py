@@ -230,7 +230,8 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
     cache = _result_cache(options, rules) if use_cache else None
     files = collect_files(paths, skipped)
     if not process_pool.can_fork():  # Windows, macOS: in this process, without limits
-        return merge_included([settle(lint_file(path, rules, options, cache), options) for path in files])
+        return [settle(result, options) for result in merge_included([lint_file(path, rules, options, cache)
+                                                                       for path in files])]
     sizes = [_size(path) for path in files]
     workers = _workers(jobs, sizes, options.sim)
     take_learned()  # what this process knows already need not come back from every child
@@ -247,8 +248,8 @@ def lint_paths(paths: Iterable[Path], options: LintOptions, use_cache: bool = Tr
         else:
             result = LintResult(display_path(files[index]), False, [], _stopped(display_path(files[index]), kind,
                                                                                  payload, limit))
-        results[index] = settle(result, options)
-    return merge_included(results)
+        results[index] = result
+    return [settle(result, options) for result in merge_included(results)]  # merged first: the counts agree
 
 
 def file_time_limit(options: LintOptions) -> float | None:

@@ -2,8 +2,11 @@
 
 A macro file's defect is found once per robot that expands it: linting a folder of 12 robots that
 include ``hand.xacro`` reported the same path, line and message 12 times (49 repeats in the quietness
-corpus). :func:`merge_included` keeps the first and counts the others in its message; the hint names
-them. Findings in the linted file itself are never merged: two robots may well share a mistake.
+corpus). :func:`merge_included` keeps the first and drops the repeats found through other linted files;
+the kept one's hint counts and names them. Its message is left as it is, so a baseline written on a whole
+folder still matches a run on one file of it (pre-commit, ``--changed-since``). Findings in the linted
+file itself are never merged (two robots may well share a mistake), nor are repeats within one file (a
+macro called twice with the same defect is two findings of that file).
 """
 
 from __future__ import annotations
@@ -16,35 +19,46 @@ NAMED = 3
 
 
 def merge_included(results: list[Any]) -> list[Any]:
-    """``results`` (:class:`~ar3cli.lint.engine.LintResult`, in order) with each finding that points into
-    an included file (its path is not the linted file's) kept in the first result that has it and dropped
-    from the others, its message saying how many linted files include it. Results without such repeats come
-    back as they are."""
-    first: dict[tuple, tuple[int, int]] = {}  # finding identity -> (result index, finding index)
+    """``results`` (unsettled :class:`~ar3cli.lint.engine.LintResult`, in order) with each finding that points
+    into an included file (its path is not the linted file's) kept in the first result that has it and dropped
+    from the later ones, its hint naming them; the suppressed findings likewise, so that the counts a run
+    reports (suppressed, made less severe) agree with what it shows. Results without such repeats come back
+    as they are."""
+    owner: dict[tuple, int] = {}  # finding identity -> the index of the first result that has it
     also: dict[tuple, list[str]] = {}
-    kept: list[list] = []
     for number, result in enumerate(results):
-        findings = []
-        for finding in result.findings:
-            if finding.path == result.path:
-                findings.append(finding)
-                continue
-            key = (finding.path, finding.line, finding.column, finding.rule, finding.message)
-            if key in first:
+        for key in {_key(finding) for finding in _all_findings(result) if finding.path != result.path}:
+            if key in owner:
                 also[key].append(result.path)
-                continue
-            first[key] = (number, len(findings))
-            also[key] = []
-            findings.append(finding)
-        kept.append(findings)
+            else:
+                owner[key], also[key] = number, []
     if not any(also.values()):
         return results
-    for key, others in also.items():
-        if others:
-            number, index = first[key]
-            finding = kept[number][index]
-            listed = ", ".join(others[:NAMED]) + (", ..." if len(others) > NAMED else "")
-            kept[number][index] = dataclasses.replace(
-                finding, message=f"{finding.message} (found through {len(others) + 1} linted files that include it)",
-                hint=f"{finding.hint} Also found through: {listed}.".strip())
-    return [dataclasses.replace(result, findings=findings) for result, findings in zip(results, kept)]
+    merged = []
+    for number, result in enumerate(results):
+        def kept(finding, number=number, result=result) -> bool:
+            return finding.path == result.path or owner[_key(finding)] == number
+
+        findings = [_named(finding, also[_key(finding)]) if finding.path != result.path else finding
+                    for finding in result.findings if kept(finding)]
+        suppressed = [item for item in result.suppressed if kept(item.finding)]
+        merged.append(dataclasses.replace(result, findings=findings, suppressed=suppressed))
+    return merged
+
+
+def _all_findings(result: Any):
+    yield from result.findings
+    yield from (item.finding for item in result.suppressed)
+
+
+def _key(finding: Any) -> tuple:
+    return (finding.path, finding.line, finding.column, finding.rule, finding.message)
+
+
+def _named(finding: Any, others: list[str]) -> Any:
+    """``finding`` with a hint that says which other linted files include its file (unchanged when none)."""
+    if not others:
+        return finding
+    listed = ", ".join(others[:NAMED]) + (", ..." if len(others) > NAMED else "")
+    return dataclasses.replace(finding, hint=f"{finding.hint or ''} Found through {len(others) + 1} linted files "
+                                             f"that include it; also: {listed}.".strip())
