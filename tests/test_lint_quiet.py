@@ -70,6 +70,7 @@ def test_meshes_mujoco_finds_through_its_meshdir():
     assert "G001" not in _codes(mujoco_only)
     also_ros = [f for f in _lint("mujoco_meshdir/robot.urdf", targets=("mujoco", "ros")) if f.rule == "G001"]
     assert len(also_ros) == 2 and all("only MuJoCo finds it" in f.message for f in also_ros)
+    assert all(str(DATA) not in f.message for f in also_ros)  # the meshdir as written, not the machine's folder
     default = [f for f in _lint("mujoco_meshdir/robot.urdf") if f.rule == "G001"]  # PyBullet and ROS do not
     assert len(default) == 2 and all(f.severity is Severity.ERROR for f in default)
 

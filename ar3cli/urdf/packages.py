@@ -68,11 +68,19 @@ class Resolution:
 
 
 def shown_places(places: Sequence[str], folder: str | os.PathLike[str]) -> list[str]:
-    """The places a search tried, as a message shows them: those inside the current folder (relative
-    to it) or inside the robot's ``folder``, in order; the others (the folders above the checkout,
-    ``ROS_PACKAGE_PATH`` and ``AMENT_PREFIX_PATH`` entries) only counted. Their names are the
-    machine's layout, not the robot's, and a linted pull request must not learn it
-    (docs/security.md)."""
+    """The places a search tried, as a message shows them (:func:`split_places`), the hidden ones as one
+    last item ("3 places outside the robot's folder")."""
+    shown, hidden = split_places(places, folder)
+    if hidden:
+        shown.append(f"{hidden} place{'s' if hidden != 1 else ''} outside the robot's folder")
+    return shown
+
+
+def split_places(places: Sequence[str], folder: str | os.PathLike[str]) -> tuple[list[str], int]:
+    """(the places a message may name: those inside the current folder (relative to it) or inside the robot's
+    ``folder``, in order; how many others there were: the folders above the checkout, ``ROS_PACKAGE_PATH``
+    and ``AMENT_PREFIX_PATH`` entries). Their names are the machine's layout, not the robot's, and a linted
+    pull request must not learn it (docs/security.md)."""
     here = os.getcwd()
     roots = [root.rstrip(os.sep) + os.sep for root in (here, os.fspath(folder)) if root]
     shown: list[str] = []
@@ -87,9 +95,7 @@ def shown_places(places: Sequence[str], folder: str | os.PathLike[str]) -> list[
             shown.append(place)
         else:
             hidden += 1
-    if hidden:
-        shown.append(f"{hidden} place{'s' if hidden != 1 else ''} outside the robot's folder")
-    return shown
+    return shown, hidden
 
 
 ANCESTORS = "ancestors of the robot's folder"

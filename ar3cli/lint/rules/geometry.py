@@ -11,6 +11,7 @@ from ar3cli.lint.rules.base import LINK_INERTIAL, Hit, robot, rule
 from ar3cli.lint.rules.file import SUBSTITUTION
 from ar3cli.urdf.meshinfo import PYBULLET_MESH_FORMATS
 from ar3cli.urdf.model import parse_floats
+from ar3cli.urdf.packages import split_places
 
 MAX_PLAUSIBLE_EXTENT = 5.0
 """A robot part larger than this many metres after scaling is almost always a mesh in millimetres."""
@@ -82,15 +83,17 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
         if resolution is not None and not resolution.found and not resolution.problem.startswith("empty package"):
             tried, hint = "", None
             if places := resolution.places():  # the message names the first place, the hint every one (11 on a line)
-                more = len(places) - 1
-                tried = f"; looked in {places[0]}" + (f" and {more} more place{'s' if more > 1 else ''}" if more else "")
+                named, _hidden = split_places(resolution.tried, resolution.folder)
+                more = len(resolution.tried) - 1
+                tried = (f"; looked in {places[0]}" + (f" and {more} more place{'s' if more > 1 else ''}" if more else "")
+                         if named else f"; looked in {places[0]}")  # only places outside: their count
                 hint = f"{G001_FIX} Looked in: " + "; ".join(places) + "."
             also = ""
             if meshdir is not None and ctx.model.resolver.is_file(meshdir / _base_name(resolution.uri)):
                 others = [target for target in ctx.targets if target != "mujoco"]
                 if not others:
                     continue  # MuJoCo, the only target, finds it through its own meshdir
-                also = f" (only MuJoCo finds it, in its <compiler meshdir> {meshdir})"
+                also = f" (only MuJoCo finds it, in its <compiler meshdir=\"{_written_meshdir(ctx.model)}\">)"
             yield Hit(f"link '{link.name}' mesh {resolution.uri}: {resolution.problem or 'not found'}{also}{tried}",
                       geometry.element, hint=hint)
 
@@ -98,11 +101,17 @@ def mesh_not_found(ctx) -> Iterator[Hit]:
 def mujoco_meshdir(model) -> Path | None:
     """The folder MuJoCo looks for this file's meshes in: ``<mujoco><compiler meshdir="..."/>`` under
     ``<robot>``, relative to the file's folder; None without one."""
+    written = _written_meshdir(model)
+    return model.resolver.base_dir / written if written else None
+
+
+def _written_meshdir(model) -> str | None:
+    """``<compiler meshdir>`` as the file writes it (what a message shows: never the machine's folders)."""
     for block in model.root.findall("mujoco"):
         for compiler in block.findall("compiler"):
             folder = compiler.get("meshdir")
             if folder and folder.strip():
-                return model.resolver.base_dir / folder.strip()
+                return folder.strip()
     return None
 
 
