@@ -134,3 +134,26 @@ def test_fix_hint_asks_no_density_for_frame_links(tmp_path):
         '<collision><geometry><box size="0.1 0.1 0.1"/></geometry></collision>')))
     assert fix_commands("robot.urdf", [f for f in part if f.rule == "I002"]) == [
         "ar3cli fix-inertia robot.urdf --density KG_PER_M3  # I002"]
+
+
+def test_root_welded_links_get_a_fix_inertia_command_that_works(tmp_path):
+    """I012's hint said 'run ar3cli fix-inertia', which selects none of the welded links (they are not I002
+    any more), and gave a chassis with geometry a tiny inertial (found in review)."""
+    frames = robot(f"""<link name="base">{LINK_INERTIAL}</link><link name="cam"/><link name="imu"/>
+        <joint name="a" type="fixed"><parent link="base"/><child link="cam"/></joint>
+        <joint name="b" type="fixed"><parent link="base"/><child link="imu"/></joint>""")
+    (finding,) = codes_for(write_fixture(tmp_path / "frames", frames), "I012")
+    assert "for each to its base" in finding.message
+    assert "ar3cli fix-inertia --links cam,imu (a tiny <inertial> for each frame)" in finding.hint
+    one = robot(f"""<link name="base">{LINK_INERTIAL}</link><link name="cam"/>
+        <joint name="a" type="fixed"><parent link="base"/><child link="cam"/></joint>""")
+    (finding,) = codes_for(write_fixture(tmp_path / "one", one), "I012")
+    assert "1 link welded to root link 'base' has no <inertial> ('cam')" in finding.message
+    assert "1 kg and I = 1 for it to its base" in finding.message
+    chassis = robot("""<link name="base_footprint"/>
+        <link name="base"><collision><geometry><box size="0.5 0.3 0.1"/></geometry></collision></link>
+        <link name="imu"/><joint name="a" type="fixed"><parent link="base_footprint"/><child link="base"/></joint>
+        <joint name="b" type="fixed"><parent link="base"/><child link="imu"/></joint>""")
+    (finding,) = codes_for(write_fixture(tmp_path / "chassis", chassis), "I012")
+    assert "ar3cli fix-inertia --links base,imu --density KG_PER_M3" in finding.hint
+    assert "give 'base_footprint' a tiny <inertial>" in finding.hint

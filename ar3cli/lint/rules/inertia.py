@@ -606,29 +606,45 @@ def root_inertial_missing(ctx) -> Iterator[Hit]:
     root = roots[0]
     if root.name == "world":
         return  # PyBullet's only mass-0 default: a static base, with whatever is welded to it
-    welded = [name for name in ctx.rigid_body(root).members if name not in (root.name, "world")
+    welded = [ctx.model.link(name) for name in ctx.rigid_body(root).members if name not in (root.name, "world")
               and ctx.model.link(name).inertial is None]
-    shown = ", ".join(f"'{name}'" for name in welded[:3]) + (", ..." if len(welded) > 3 else "")
-    also = (f", nor {'do' if len(welded) > 1 else 'does'} the {len(welded)} link{'s' if len(welded) > 1 else ''} "
-            f"welded to it ({shown})" if welded else "")
+    names = ", ".join(f"'{link.name}'" for link in welded[:3]) + (", ..." if len(welded) > 3 else "")
+    they = _plural(len(welded), "link")
+    also = f", nor {'do' if len(welded) > 1 else 'does'} the {they} welded to it ({names})" if welded else ""
     gets = f"PyBullet gives {'each' if welded else 'it'} 1 kg and I = 1, Drake no mass at all"
     below = [joint.type for joint in ctx.model.joints if joint.parent == root.name]
     if root.inertial is None and root.has_geometry:
         yield Hit(f"root link '{root.name}' has geometry but no <inertial>{also}: if this robot floats, {gets}",
-                  root.element,
-                  hint=f"If the robot floats: ar3cli fix-inertia --links {root.name} --density KG_PER_M3 (or write "
-                       "the real <inertial>); a fixed-base arm can ignore this.")
+                  root.element, hint=_floating_fix(ctx, [root, *welded]))
     elif root.inertial is None and below and all(kind == "fixed" for kind in below):
         yield Hit(f"root link '{root.name}' is a frame (no geometry) with no <inertial>{also}, on top of a body: "
-                  f"if this robot floats, {gets}", root.element,
-                  hint="If the robot floats: give it a tiny <inertial> (mass 1e-6 kg, I = 1e-12) or run ar3cli "
-                       "fix-inertia; a fixed-base robot can ignore this.")
+                  f"if this robot floats, {gets}", root.element, hint=_floating_fix(ctx, [root, *welded]))
     elif welded:
-        yield Hit(f"{len(welded)} link{'s' if len(welded) > 1 else ''} welded to root link '{root.name}' "
-                  f"{'have' if len(welded) > 1 else 'has'} no <inertial> ({shown}): if this robot floats, PyBullet adds "
-                  "1 kg and I = 1 for each to its base", root.element,
-                  hint="If the robot floats: give each a tiny <inertial> (mass 1e-6 kg, I = 1e-12) or run ar3cli "
-                       "fix-inertia; a fixed-base robot can ignore this.")
+        yield Hit(f"{they} welded to root link '{root.name}' {'have' if len(welded) > 1 else 'has'} no <inertial> "
+                  f"({names}): if this robot floats, PyBullet adds 1 kg and I = 1 for {'each' if len(welded) > 1 else 'it'} "
+                  "to its base", root.element, hint=_floating_fix(ctx, welded))
+
+
+def _plural(count: int, noun: str) -> str:
+    return f"{count} {noun}{'s' if count != 1 else ''}"
+
+
+def _floating_fix(ctx, links) -> str:
+    """I012's hint, for a robot that floats: fix-inertia with a density for the parts with geometry, without
+    one for the frames welded below (it gives them a tiny inertial), and a tiny inertial written by hand for a
+    root frame (fix-inertia computes nothing for a link without geometry or a fixed joint above it)."""
+    parts = [link.name for link in links if link.has_geometry]
+    welded_frames = [link.name for link in links if not link.has_geometry and ctx.model.parent_joint(link.name)]
+    root_frames = [link.name for link in links if not link.has_geometry and not ctx.model.parent_joint(link.name)]
+    commands = []
+    if parts:  # one command: the frames among them get a tiny inertial whatever the density
+        commands.append(f"ar3cli fix-inertia --links {','.join(parts + welded_frames)} --density KG_PER_M3 (or "
+                        "write the real <inertial>)")
+    elif welded_frames:
+        commands.append(f"ar3cli fix-inertia --links {','.join(welded_frames)} (a tiny <inertial> for each frame)")
+    if root_frames:
+        commands.append(f"give '{root_frames[0]}' a tiny <inertial> (mass 1e-6 kg, I = 1e-12)")
+    return f"If the robot floats: {'; '.join(commands)}; a fixed-base robot can ignore this."
 
 
 FIXED_BY_FIX_INERTIA = (inertial_missing, fixed_link_inertial_missing, mass_not_positive, inertia_not_positive_definite,
