@@ -115,6 +115,9 @@ def test_fix_inertia_names_the_densities_it_does_not_touch(cli, tmp_path):
     assert result.code in (0, 1), result.stderr
     assert "density no material has alone (I013, not a mass in grams): upper" in result.stdout + result.stderr
     assert path.read_bytes() == before
+    given = cli("fix-inertia", str(path), "--mass", "upper=2")  # a --mass for a link no other rule selects
+    assert "density no material has alone (I013, not a mass in grams): upper" in given.stdout + given.stderr
+    assert path.read_bytes() == before
 
 
 def test_density_is_judged_on_the_collision_alone_when_a_link_has_no_visual(tmp_path):

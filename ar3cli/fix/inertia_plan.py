@@ -177,13 +177,19 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
 
     plan = FixPlan()
     cache: dict = {}
-    rescaled = set() if options.all_links or options.link_names else _rescale_units(model, document, plan, options)
+    rescaled, implausible = (set(), []) if options.all_links or options.link_names else \
+        _rescale_units(model, document, plan, options)
     selected, left_alone = _select(model, options)
     selected = {name: reason for name, reason in selected.items() if name not in rescaled}
     left_alone = [item for item in left_alone if item.link not in rescaled]
     if left_alone:
         plan.notes.append(_left_alone_note(left_alone))
         plan.data["left_alone"] = [asdict(item) for item in left_alone]
+    unexplained = [name for name in implausible if name not in selected]
+    if unexplained:  # I013 names fix-inertia for grams only: say which densities it did not touch, and why
+        plan.notes.append(f"left {len(unexplained)} link(s) whose density no material has alone (I013, not a mass in "
+                          f"grams): {listed(unexplained)}; check their <mass> and collision sizes, or recompute "
+                          "with --links NAME --density KG_PER_M3")
     targets: list[_Target] = []
     for name, reason in selected.items():
         link = model.link(name)
@@ -218,11 +224,12 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
     return plan
 
 
-def _rescale_units(model, document: Document, plan: FixPlan, options: InertiaOptions) -> set[str]:
+def _rescale_units(model, document: Document, plan: FixPlan, options: InertiaOptions) -> tuple[set[str], list[str]]:
     """Divide the mass and tensor of the links whose numbers the linter says are in another unit (a mass in
     grams, I013; a tensor in kg·mm² or g·mm², I007: :func:`~ar3cli.lint.rules.inertia.unit_mistakes`): the
     file's own values in kg and kg·m², the one right answer (centre of mass and axes kept). Links given a
-    --mass, or whose findings an inline comment ignores, are left to the other paths. The names done."""
+    --mass, or whose findings an inline comment ignores, are left to the other paths. (The names done, the
+    links whose I013 is not a mass in grams: fix-inertia says it leaves them, unless it recomputes them.)"""
     from ar3cli.lint.context import Context
     from ar3cli.lint.engine import suppressed_inline
     from ar3cli.lint.rules.inertia import unit_mistakes
@@ -236,11 +243,7 @@ def _rescale_units(model, document: Document, plan: FixPlan, options: InertiaOpt
     finally:
         context.close()
     unexplained = [name for hit in implausible if (owner := _owning_link(hit.element)) is not None
-                   and (name := owner.get("name", "")) not in mistakes and name not in options.masses]
-    if unexplained:  # I013 names fix-inertia for grams only: say which densities it did not touch, and why
-        plan.notes.append(f"left {len(unexplained)} link(s) whose density no material has alone (I013, not a mass in "
-                          f"grams): {listed(unexplained)}; check their <mass> and collision sizes, or recompute "
-                          "with --links NAME --density KG_PER_M3")
+                   and (name := owner.get("name", "")) not in mistakes]
     done: set[str] = set()
     for name, (mass_divisor, tensor_divisor, reason) in mistakes.items():
         link = model.link(name)
@@ -263,7 +266,7 @@ def _rescale_units(model, document: Document, plan: FixPlan, options: InertiaOpt
             plan.changes.append(Change(element, tensor.sourceline or link.line, "inertia", _tensor_text(old),
                                        _tensor_text(new), reason))
         done.add(name)
-    return done
+    return done, unexplained
 
 
 def _valid_file_mass(link) -> float | None:
