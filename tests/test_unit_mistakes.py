@@ -118,6 +118,11 @@ def test_fix_inertia_names_the_densities_it_does_not_touch(cli, tmp_path):
     given = cli("fix-inertia", str(path), "--mass", "upper=2")  # a --mass for a link no other rule selects
     assert "density no material has alone (I013, not a mass in grams): upper" in given.stdout + given.stderr
     assert path.read_bytes() == before
+    # selected by another rule (a tensor that breaks the triangle inequality): recomputed around its own mass,
+    # so its density is still no material's, and the note still says so (the sweep's TIAGo tool links)
+    path.write_text(before.decode().replace('izz="0.0021"', 'izz="0.05"'))
+    recomputed = cli("fix-inertia", str(path))
+    assert "density no material has alone (I013, not a mass in grams): upper" in recomputed.stdout + recomputed.stderr
 
 
 def test_density_is_judged_on_the_collision_alone_when_a_link_has_no_visual(tmp_path):

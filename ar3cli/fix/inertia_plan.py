@@ -124,6 +124,10 @@ class _Target:
     """Why no mass source applies (shown instead of the generic "give --density ..." when set)."""
 
 
+KEPT = "mass kept from file"
+"""The mass source of a link whose tensor is recomputed around the file's own mass (its density unchanged)."""
+
+
 def parse_masses(values: list[str] | None) -> dict[str, float]:
     """``LINK=KG`` pairs; malformed ones, and masses below :data:`SMALLEST_MASS`, raise UserError."""
     masses: dict[str, float] = {}
@@ -185,11 +189,6 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
     if left_alone:
         plan.notes.append(_left_alone_note(left_alone))
         plan.data["left_alone"] = [asdict(item) for item in left_alone]
-    unexplained = [name for name in implausible if name not in selected]
-    if unexplained:  # I013 names fix-inertia for grams only: say which densities it did not touch, and why
-        plan.notes.append(f"left {len(unexplained)} link(s) whose density no material has alone (I013, not a mass in "
-                          f"grams): {listed(unexplained)}; check their <mass> and collision sizes, or recompute "
-                          "with --links NAME --density KG_PER_M3")
     targets: list[_Target] = []
     for name, reason in selected.items():
         link = model.link(name)
@@ -219,6 +218,12 @@ def plan_inertia(model, document: Document, options: InertiaOptions) -> FixPlan:
         props = mp.scaled_to_mass(target.geometry.props, target.mass)
         geometry_source = f"{target.geometry.role}: " + listed(target.geometry.sources, separator="; ")
         _write_inertial(document, plan, target.link, props, target.mass_source, geometry_source)
+    new_mass = {target.link.name for target in targets if target.mass is not None and target.mass_source != KEPT}
+    unexplained = [name for name in implausible if name not in new_mass]
+    if unexplained:  # I013 names fix-inertia for grams only: say which densities it did not touch, and why
+        plan.notes.append(f"left {len(unexplained)} link(s) whose density no material has alone (I013, not a mass in "
+                          f"grams): {listed(unexplained)}; check their <mass> and collision sizes, or recompute "
+                          "with --links NAME --density KG_PER_M3")
     plan.changes.sort(key=lambda change: change.line)
     plan.skipped.sort(key=lambda skipped: skipped.line)
     return plan
@@ -282,7 +287,7 @@ def _assign_masses(model, targets: list[_Target], options: InertiaOptions, plan:
         if name in options.masses:
             target.mass, target.mass_source = options.masses[name], f"--mass {name}={number(options.masses[name])}"
         elif file_mass is not None:
-            target.mass, target.mass_source = file_mass, "mass kept from file"
+            target.mass, target.mass_source = file_mass, KEPT
         elif options.density is not None:
             target.mass = options.density * target.geometry.volume
             target.mass_source = (f"density {number(options.density)} kg/m3 x volume "
