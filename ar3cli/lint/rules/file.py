@@ -197,8 +197,10 @@ LIBRARY = "F008"
       entry file's findings point at this file's lines. This one line says so, and names the files of
       its package that include it. The same holds for a fragment that does not expand alone because it
       reads what its includer defines ($(arg model_dir) declared by the entry file, a $(find pkg) only
-      its workspace resolves): when a file of its package includes it, the expansion's failure is the
-      includer's to report (xacro stops there too), and this line names the includer and the reason.""",
+      its workspace resolves): when a file of its package includes it and expands, the failure alone is
+      the includer's context missing, and this line names the includer and the reason. A fragment no
+      expanding includer vouches for keeps its F004 error: a pull request cannot silence a broken robot by
+      adding a file that includes it, nor pass one pre-commit lints without its includer.""",
       fix="Nothing to fix here: lint the entry file that includes it (lint-urdf on the folder does).",
       bad='''<?xml version="1.0"?>
 <robot xmlns:xacro="http://www.ros.org/wiki/xacro">
