@@ -192,14 +192,6 @@ def _com_robot(com: str) -> str:
           <limit lower="-1" upper="1" effort="10" velocity="1"/></joint>""")
 
 
-def _union(boxes):
-    boxes = [box for box in boxes if box is not None]
-    if not boxes:
-        return None
-    return (tuple(min(box[0][i] for box in boxes) for i in range(3)),
-            tuple(max(box[1][i] for box in boxes) for i in range(3)))
-
-
 def _outside(point, box) -> float:
     """Distance from ``point`` to ``box`` (0 inside)."""
     return math.sqrt(sum(max(0.0, lo - p, p - hi) ** 2 for p, lo, hi in zip(point, *box)))
@@ -211,7 +203,7 @@ def com_outside(ctx, link) -> tuple[float, float, str] | None:
     inertial = link.inertial
     if inertial is None or inertial.origin.element is None or not (inertial.mass or 0) > 0:
         return None
-    box = _union([ctx.shape_bounds(shape) for shape in (*link.visuals, *link.collisions)])
+    box = ctx.body_bounds(link)
     com = inertial.origin.xyz
     if box is None or not all(map(math.isfinite, (*com, *box[0], *box[1]))):
         return None
@@ -250,7 +242,7 @@ def _typical_com_offset(ctx) -> float | None:
         ratios = []
         for link in ctx.model.links:
             inertial = link.inertial
-            box = _union([ctx.shape_bounds(shape) for shape in (*link.visuals, *link.collisions)])
+            box = ctx.body_bounds(link)
             if inertial is None or box is None or not all(map(math.isfinite, inertial.origin.xyz)):
                 continue
             size, offset = math.dist(*box), math.hypot(*inertial.origin.xyz)
