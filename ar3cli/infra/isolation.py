@@ -34,7 +34,7 @@ from typing import BinaryIO, TypeVar
 from ar3cli.errors import EXIT_USAGE, UserError
 from ar3cli.infra import child_limits, shutdown
 from ar3cli.infra.outcome import OutOfMemory, capture, pickled, read_until, unwrap
-from ar3cli.infra.process_pool import can_fork, child_signals, interrupts_deferred, stop_children
+from ar3cli.infra.process_pool import can_fork, fork_child, interrupts_deferred, stop_children
 
 Result = TypeVar("Result")
 
@@ -166,20 +166,17 @@ def _start(work: Callable[[], Result], folder: str, mask: set[signal.Signals]) -
     for stream in (sys.stdout, sys.stderr):
         stream.flush()  # what is buffered now must not be written twice
     read_end, write_end = os.pipe()
-    parent = os.getpid()
+
+    def in_child() -> None:
+        os.close(read_end)
+        _run_child(work, folder, os.fdopen(write_end, "wb"))
+
     try:
-        pid = os.fork()
+        pid = fork_child(mask, in_child)
     except OSError as exc:
         os.close(read_end)
         os.close(write_end)
         raise UserError(f"cannot start a process for pybullet: {exc.strerror or exc}") from None
-    if pid == 0:  # the child: never returns
-        try:
-            child_signals(mask, parent)
-            os.close(read_end)
-            _run_child(work, folder, os.fdopen(write_end, "wb"))
-        finally:
-            os._exit(0)
     os.close(write_end)
     return pid, os.fdopen(read_end, "rb")
 

@@ -132,6 +132,21 @@ def child_signals(mask: set[signal.Signals], parent: int) -> None:
     signal.pthread_sigmask(signal.SIG_SETMASK, mask)
 
 
+def fork_child(mask: set[signal.Signals], run: Callable[[], None]) -> int:
+    """Fork a child that sets up its signals (:func:`child_signals`: it dies with this process, restores
+    ``mask``), runs ``run()`` and exits without returning, whatever happens; the child's pid, in the parent.
+    OSError when the system refuses a process."""
+    parent = os.getpid()
+    pid = os.fork()
+    if pid == 0:  # the child: never returns
+        try:
+            child_signals(mask, parent)
+            run()
+        finally:
+            os._exit(0)
+    return pid
+
+
 def _start_child(function: Callable[[Item], Result], share: Sequence[Item], siblings: list[BinaryIO],
                  mask: set[signal.Signals]) -> tuple[int, BinaryIO] | None:
     """Fork a child that runs ``function`` over ``share`` and pickles the outcome into a pipe;
@@ -143,23 +158,21 @@ def _start_child(function: Callable[[Item], Result], share: Sequence[Item], sibl
     except OSError:
         return None
     parent = os.getpid()
+
+    def in_child() -> None:
+        os.close(read_end)
+        for pipe in siblings:
+            pipe.close()
+        answer = pickled(capture(lambda: [_unless_orphaned(parent, function, item) for item in share]))
+        with os.fdopen(write_end, "wb") as pipe:
+            pipe.write(answer)
+
     try:
-        pid = os.fork()
+        pid = fork_child(mask, in_child)
     except OSError:
         os.close(read_end)
         os.close(write_end)
         return None
-    if pid == 0:  # the child: never returns
-        try:
-            child_signals(mask, parent)
-            os.close(read_end)
-            for pipe in siblings:
-                pipe.close()
-            answer = pickled(capture(lambda: [_unless_orphaned(parent, function, item) for item in share]))
-            with os.fdopen(write_end, "wb") as pipe:
-                pipe.write(answer)
-        finally:
-            os._exit(0)
     os.close(write_end)
     return pid, os.fdopen(read_end, "rb")
 

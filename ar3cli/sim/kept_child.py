@@ -131,31 +131,25 @@ class KeptChild(Generic[State]):
 
     def _start(self, setup: Callable[[], State]) -> None:
         from ar3cli.infra import child_limits
-        from ar3cli.infra.process_pool import interrupts_deferred
+        from ar3cli.infra.process_pool import fork_child, interrupts_deferred
 
         for stream in (sys.stdout, sys.stderr):
             stream.flush()  # what is buffered now must not be written twice
         child_limits.prepare()
         request_read, request_write = os.pipe()
         answer_read, answer_write = os.pipe()
-        parent = os.getpid()
+        def in_child() -> None:
+            os.close(request_write)
+            os.close(answer_read)
+            self._serve(setup, os.fdopen(request_read, "rb"), os.fdopen(answer_write, "wb"))
+
         with interrupts_deferred() as mask:  # a Ctrl-C between fork and bookkeeping would lose the child
             try:
-                pid = os.fork()
+                pid = fork_child(mask, in_child)
             except OSError as exc:
                 for fd in (request_read, request_write, answer_read, answer_write):
                     os.close(fd)
                 raise UserError(f"cannot start a process for pybullet: {exc.strerror or exc}") from None
-            if pid == 0:  # the child: never returns
-                try:
-                    from ar3cli.infra.process_pool import child_signals
-
-                    child_signals(mask, parent)
-                    os.close(request_write)
-                    os.close(answer_read)
-                    self._serve(setup, os.fdopen(request_read, "rb"), os.fdopen(answer_write, "wb"))
-                finally:
-                    os._exit(0)
             self._pid = pid
         os.close(request_read)
         os.close(answer_write)
