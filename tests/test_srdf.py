@@ -213,8 +213,8 @@ def test_an_srdf_given_that_disables_nothing_is_not_replaced_by_the_packages(tmp
     package = tmp_path / "pkg"
     shutil.copytree(REPO / "tests" / "data" / "quiet" / "srdf_package", package)
     model = load_model(package / "urdf" / "arm.urdf")
-    own, note = moveit_disabled(model)
-    assert own.explicit and "arm.srdf" in note
+    own, srdf = moveit_disabled(model)
+    assert own.explicit and srdf.name == "arm.srdf"
     (tmp_path / "mine.srdf").write_text('<robot name="arm"><group name="g"/></robot>')
     given = disabled_pairs(tmp_path / "mine.srdf")
     assert moveit_disabled(model, given) == (given, None)

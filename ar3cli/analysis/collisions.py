@@ -9,6 +9,8 @@ from typing import TYPE_CHECKING, Any
 from ar3cli.analysis.robot import RobotAnalysis, question
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
     from ar3cli.collisions.run import MatrixRun
     from ar3cli.urdf.srdf_read import DisabledPairs
 
@@ -37,9 +39,9 @@ def collision_matrix(analysis: RobotAnalysis) -> CollisionMatrix:
 
 
 @question
-def moveit_disabled_pairs(analysis: RobotAnalysis) -> tuple[DisabledPairs, str | None]:
-    """The link pairs MoveIt is told not to check (the settings' ``--srdf``, else the package's own SRDF) and
-    a note naming that SRDF: contact at home there is not a warning, as for lint-urdf's P002
+def moveit_disabled_pairs(analysis: RobotAnalysis) -> tuple[DisabledPairs, Path | None]:
+    """The link pairs MoveIt is told not to check (the settings' ``--srdf``, else the package's own SRDF, which
+    comes back too): contact at home there is not a warning, as for lint-urdf's P002
     (:func:`~ar3cli.urdf.srdf_read.moveit_disabled`)."""
     from ar3cli.urdf.srdf_read import moveit_disabled
 
@@ -49,11 +51,8 @@ def moveit_disabled_pairs(analysis: RobotAnalysis) -> tuple[DisabledPairs, str |
 def disabled_in_srdf(analysis: RobotAnalysis, pairs) -> tuple[list, str]:
     """``pairs`` ((link a, link b), ...) MoveIt is told not to check, and the words naming where that is said
     ('' when none is)."""
-    from ar3cli.urdf.srdf_read import is_disabled
-
-    disabled, note = moveit_disabled_pairs(analysis)
-    found = [pair for pair in pairs if is_disabled(disabled, *pair)]
+    disabled, srdf = moveit_disabled_pairs(analysis)
+    found = [pair for pair in pairs if disabled.covers(*pair)]
     if not found:
         return [], ""
-    source = note.split(" (", 1)[0].removeprefix("pairs disabled by ") if note else "the --srdf SRDF"
-    return found, source
+    return found, f"the package's SRDF {srdf.name}" if srdf is not None else "the --srdf SRDF"

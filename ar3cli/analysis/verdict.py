@@ -196,16 +196,16 @@ def collisions_check(analysis: RobotAnalysis) -> Outcome:
     """The collision matrix's warnings (contact at home, pairs PyBullet checks although they always
     touch, links without collision geometry); its info (contact only at a joint limit) is counted, not failed."""
     from ar3cli.analysis.collisions import collision_matrix, disabled_in_srdf
-    from ar3cli.collisions.matrix import pair_label
+    from ar3cli.collisions.matrix import contact_at_home
     from ar3cli.findings import Severity
 
     matrix = collision_matrix(analysis)
     at_home = [(result.link_a, result.link_b) for result in matrix.run.results
                if result.at_home and result.category != "adjacent"]
     allowed, source = disabled_in_srdf(analysis, at_home)
-    labels = {pair_label(*pair) for pair in allowed}
+    disabled = {contact_at_home(*pair) for pair in allowed}
     warnings = [finding for finding in matrix.run.warnings if finding.severity >= Severity.WARNING
-                and not (finding.rule == "contact-at-home" and finding.message.split(" are ", 1)[0] in labels)]
+                and not (finding.rule == "contact-at-home" and finding.message in disabled)]
     infos = len([finding for finding in matrix.run.warnings if finding.severity < Severity.WARNING])
     kinds: dict[str, int] = {}
     for finding in warnings:

@@ -212,8 +212,7 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
         key = frozenset((result.link_a, result.link_b))
         label = pair_label(result.link_a, result.link_b)
         if result.at_home and result.category != "adjacent":
-            found.append(Finding("contact-at-home", Severity.WARNING,
-                                 f"{label} are in contact at the home pose but not adjacent", path,
+            found.append(Finding("contact-at-home", Severity.WARNING, contact_at_home(result.link_a, result.link_b), path,
                                  hint="usually a modelling error (check the collision origins and sizes); "
                                       "PyBullet's URDF_USE_SELF_COLLISION would report this contact too"))
         elif key not in adjacent_direct and result.fraction >= always_threshold:
@@ -233,6 +232,11 @@ def findings(model: Model, results: Sequence[PairResult], links: Sequence[str],
 def pair_label(link_a: str, link_b: str) -> str:
     """``a - b``: how a finding names a link pair (its message starts with it)."""
     return f"{link_a} - {link_b}"
+
+
+def contact_at_home(link_a: str, link_b: str) -> str:
+    """The message of the contact-at-home warning about the pair (report's verdict tells its pairs by it)."""
+    return f"{pair_label(link_a, link_b)} are in contact at the home pose but not adjacent"
 
 
 def _samples(result: PairResult) -> str:

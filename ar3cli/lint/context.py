@@ -68,7 +68,10 @@ class Context:
         if "disabled-pairs" not in self._shared:
             from ar3cli.urdf.srdf_read import moveit_disabled
 
-            self._shared["disabled-pairs"] = moveit_disabled(self.model, self.srdf_disabled)
+            pairs, srdf = moveit_disabled(self.model, self.srdf_disabled)
+            self._shared["disabled-pairs"] = (pairs, None if srdf is None else (
+                f"pairs disabled by the package's SRDF {srdf.name} (found beside the file for this robot; "
+                "--srdf FILE chooses another) are not reported"))
         return self._shared["disabled-pairs"]
 
     def shared(self, key: str, build: Callable[[Model], T]) -> T:

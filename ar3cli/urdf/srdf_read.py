@@ -198,8 +198,8 @@ def package_srdf(urdf_path: Path, robot_name: str | None, links: set[str]) -> Pa
     return None
 
 
-def moveit_disabled(model: Any, given: DisabledPairs | None = None) -> tuple[DisabledPairs, str | None]:
-    """(the link pairs MoveIt is told not to check, a note saying where they come from or None): ``given``
+def moveit_disabled(model: Any, given: DisabledPairs | None = None) -> tuple[DisabledPairs, Path | None]:
+    """(the link pairs MoveIt is told not to check, the package's SRDF they come from or None): ``given``
     (the user's ``--srdf``, even one that disables nothing), else the SRDF the package ships for ``model``
     (:func:`package_srdf`), else none. lint's P002 and M003 and report's contact verdicts leave those pairs
     alone."""
@@ -209,8 +209,6 @@ def moveit_disabled(model: Any, given: DisabledPairs | None = None) -> tuple[Dis
     if path is None:
         return DisabledPairs(), None
     try:
-        pairs = disabled_pairs(path)
+        return disabled_pairs(path), path
     except UserError:
         return DisabledPairs(), None
-    return pairs, (f"pairs disabled by the package's SRDF {path.name} (found beside the file for this robot; "
-                   "--srdf FILE chooses another) are not reported")
