@@ -144,11 +144,6 @@ def disabled_pairs(path: Path) -> DisabledPairs:
                          frozenset(srdf.no_default))
 
 
-def is_disabled(pairs: DisabledPairs, a: str, b: str) -> bool:
-    """Whether ``pairs`` (:func:`disabled_pairs`) covers the pair (a, b)."""
-    return pairs.covers(a, b)
-
-
 PACKAGE_FOLDERS = ("urdf", "robots")
 """Folder names of a ROS package's robot files: their parent is the package's root, where srdf/ and config/
 (and a loose SRDF) live."""

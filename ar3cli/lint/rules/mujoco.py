@@ -139,7 +139,6 @@ M003_FIX = ("Fix the collision geometry or the joint origin; if the overlap is b
 def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import adjacent_pairs, rigid_groups
     from ar3cli.sim.mujoco_session import home_pose
-    from ar3cli.urdf.srdf_read import is_disabled
 
     robot, _ = _compiled(ctx)
     if robot is None:
@@ -150,7 +149,7 @@ def mujoco_self_collision_home(ctx) -> Iterator[Hit]:
     stand_ins = {substitution.link for substitution in robot.substitutions}
     disabled, note = ctx.disabled_pairs()
     for a, b, depth in robot.contacts(PENETRATION):
-        if frozenset((a, b)) in adjacent or is_disabled(disabled, a, b) or \
+        if frozenset((a, b)) in adjacent or disabled.covers(a, b) or \
                 (a in group and group[a] == group.get(b)):
             continue
         if a in stand_ins or b in stand_ins:

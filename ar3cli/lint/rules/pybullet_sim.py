@@ -112,7 +112,6 @@ def _stacked_boxes(tip_z: float) -> str:
       needs_sim=True)
 def sim_self_collision_home(ctx) -> Iterator[Hit]:
     from ar3cli.sim.adjacency import nonadjacent_collisions, rigid_groups
-    from ar3cli.urdf.srdf_read import is_disabled
 
     with _loaded(ctx, self_collision="all-pairs") as body:
         home = _home(body) if body is not None else None
@@ -122,7 +121,7 @@ def sim_self_collision_home(ctx) -> Iterator[Hit]:
         group = rigid_groups(ctx.model, (joint.name for joint in body.actuated_joints))
         disabled, note = ctx.disabled_pairs()
         for a, b, depth in nonadjacent_collisions(body):
-            if is_disabled(disabled, a, b):
+            if disabled.covers(a, b):
                 continue  # the SRDF (the user's, or the package's) tells MoveIt not to check this pair
             if a in group and group[a] == group.get(b):
                 continue  # joined only by fixed joints: they can never move apart (issue 30 item 8)
