@@ -61,7 +61,13 @@ def _lint(analysis: RobotAnalysis, sim: bool) -> LintAnswer:
         message = analysis.load_error.message if analysis.load_error else "not loaded"
         result = settle(unloaded_result(load_failure(analysis.path, shown, message), options), options)
     else:
-        result = settle(lint_model(analysis.model, shown, options.rules(), options), options)
+        reuse = None
+        if not sim:  # the earlier check's work: used once by the static rules, then let go
+            reuse, analysis.lint_reuse = analysis.lint_reuse, None
+        ran = lint_model(analysis.model, shown, options.rules(), options, reuse=reuse, keep=analysis.editing and not sim)
+        if ran.carry is not None:
+            analysis.lint_carry = ran.carry
+        result = settle(ran, options)
     summary = {**summarize([result], analysis.settings.fail_on), "config_file": options.config_file, "isolated": False}
     summary["exit_code"] = exit_code(summary)
     return LintAnswer(result, summary, lint_json([result], summary), sim)

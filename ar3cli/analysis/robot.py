@@ -28,12 +28,16 @@ import threading
 from collections.abc import Callable, Hashable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Protocol, TypeVar
+from typing import TYPE_CHECKING, Any, Protocol, TypeVar
 
 from ar3cli.analysis.dependencies import Dependencies, of_load, robot_file_state
 from ar3cli.analysis.settings import AnalysisSettings
 from ar3cli.errors import UserError
 from ar3cli.urdf.model import Model
+
+if TYPE_CHECKING:
+    from ar3cli.lint.reuse import Carry, Reuse
+    from ar3cli.urdf.model_edit import Edit
 
 T = TypeVar("T")
 Q = TypeVar("Q", bound=Callable[..., Any])
@@ -70,6 +74,14 @@ class RobotAnalysis:
         self.model = model
         self.load_error = load_error
         self.dependencies = dependencies
+        self.edit: Edit | None = None
+        """How the model was made from the earlier analysis' (an editor's keystroke), or None: a load."""
+        self.lint_reuse: Reuse | None = None
+        """The earlier check's work the static findings may reuse (:mod:`ar3cli.lint.reuse`), until they are asked."""
+        self.lint_carry: Carry | None = None
+        """What the static findings leave for the check after the next edit (with ``load(..., editing=True)``)."""
+        self.editing = False
+        """Loaded for an editor: the next buffer is expected to be an edit of this one."""
         self._answers: dict[Hashable, _Slot] = {}
         self._resources: list[Closable] = []
         self._lock = threading.Lock()
@@ -78,7 +90,7 @@ class RobotAnalysis:
     # ---- loading -------------------------------------------------------------------------------
     @classmethod
     def load(cls, path: str | Path, settings: AnalysisSettings | None = None, text: str | bytes | None = None,
-             earlier: RobotAnalysis | None = None) -> RobotAnalysis:
+             earlier: RobotAnalysis | None = None, editing: bool = False) -> RobotAnalysis:
         """Read ``path`` (URDF or xacro) with ``settings``, or analyse ``text`` as its content (an
         unsaved buffer: ``package://``, relative meshes and xacro includes still start at ``path``).
 
@@ -86,6 +98,10 @@ class RobotAnalysis:
         limits as lint apply: the capped reader (and the same cap on ``text``), no entities, xacro in
         the process's policy (safe mode unless the front-end chose trusted) in a limited child.
         ``earlier`` is the analysis this one replaces: a load that fails keeps watching its files.
+        ``editing`` (an editor's buffer, checked again on each keystroke): when ``text`` is ``earlier``'s
+        with one attribute value of one link or joint changed, and no file it read changed since, the model
+        is made from ``earlier``'s (:func:`~ar3cli.urdf.model_edit.edited`, which consumes it) and the static
+        findings reuse ``earlier``'s work (:mod:`ar3cli.lint.reuse`); the same model and findings as a load.
         """
         from ar3cli.infra.safe_read import MAX_FILE_BYTES
         from ar3cli.urdf.model import load_model
@@ -95,6 +111,10 @@ class RobotAnalysis:
         source = text.encode("utf-8") if isinstance(text, str) else text
         robot_file = robot_file_state(path) if source is None else {}
         model, error = None, None
+        if editing and earlier is not None and source is not None and len(source) <= MAX_FILE_BYTES:
+            edited = cls._edited(path, settings, source, earlier)
+            if edited is not None:
+                return edited
         try:
             if source is not None and len(source) > MAX_FILE_BYTES:
                 raise UserError(f"{path}: {len(source) / 1e6:.0f} MB, larger than the {MAX_FILE_BYTES >> 20} MB "
@@ -104,8 +124,29 @@ class RobotAnalysis:
             error = exc
         except RecursionError:
             error = UserError(f"{path}: document nested too deeply to parse")
-        return cls(path, settings, source, model, error, of_load(path, model, robot_file,
-                                                                 earlier.dependencies if earlier else None))
+        analysis = cls(path, settings, source, model, error, of_load(path, model, robot_file,
+                                                                     earlier.dependencies if earlier else None))
+        analysis.editing = editing
+        return analysis
+
+    @classmethod
+    def _edited(cls, path: Path, settings: AnalysisSettings, source: bytes,
+                earlier: RobotAnalysis) -> RobotAnalysis | None:
+        """The analysis of ``source`` made from ``earlier``'s model by :func:`~ar3cli.urdf.model_edit.edited`, or
+        None (another file, other settings, a file it read changed, or not an edit that function takes)."""
+        from ar3cli.lint.reuse import Reuse
+        from ar3cli.urdf.model_edit import edited
+
+        if earlier.model is None or earlier.path != path or earlier.settings is not settings or earlier.changed():
+            return None
+        edit = edited(earlier.model, source)
+        if edit is None:
+            return None
+        analysis = cls(path, settings, source, edit.model, None, of_load(path, edit.model, {}, earlier.dependencies))
+        analysis.edit, analysis.editing = edit, True
+        if earlier.lint_carry is not None:
+            analysis.lint_reuse = Reuse(earlier.lint_carry, edit)
+        return analysis
 
     def require_model(self) -> Model:
         """The model; the load's one-line error (exit 2) when the file did not load."""

@@ -60,6 +60,25 @@ class Context:
         self._mesh_bounds: dict[tuple, Box | None] = {}
         self._session: Any = None
         self._shared: dict[str, Any] = {}
+        self._link_memos: dict[str, dict[Any, Any]] = {}
+        self._structure: dict[str, Any] = {}
+
+    def inherit(self, earlier: Context, kept: list[Link], dropped_names: set[str]) -> None:
+        """Start from what ``earlier`` (the check of the text before an edit of one attribute value) computed
+        about the links in ``kept`` and their shapes, the objects the edit did not touch, the same in both
+        models (:mod:`ar3cli.lint.reuse`), and about the tree's structure (:meth:`structure`). Boxes known by
+        link name are kept for the names of ``kept`` links, less ``dropped_names`` (the edited link's names
+        before and after, which another link may share)."""
+        link_ids = {id(link) for link in kept}
+        shape_ids = {id(shape) for link in kept for shape in (*link.visuals, *link.collisions)}
+        names = {link.name for link in kept} - dropped_names
+        self._shape_bounds = {key: box for key, box in earlier._shape_bounds.items() if key in shape_ids}
+        self._mesh_bounds = dict(earlier._mesh_bounds)  # by file and scale: a changed file is a full check
+        self._bounds = {key: box for key, box in earlier._bounds.items() if key.removeprefix("body:") in names}
+        self._link_memos = {name: {key: value for key, value in memo.items()
+                                   if (key[0] if isinstance(key, tuple) else key) in link_ids}
+                            for name, memo in earlier._link_memos.items()}
+        self._structure = dict(earlier._structure)  # an edit of a value changes no element, tag or child list
 
     def disabled_pairs(self) -> tuple[DisabledPairs, str | None]:
         """(the link pairs MoveIt is told not to check, a note saying where they come from or None): the
@@ -73,6 +92,20 @@ class Context:
                 f"pairs disabled by the package's SRDF {srdf.name} (found beside the file for this robot; "
                 "--srdf FILE chooses another) are not reported"))
         return self._shared["disabled-pairs"]
+
+    def structure(self, key: str, build: Callable[[Model], T]) -> T:
+        """``build(model)``, computed once per file for every rule that asks with the same ``key``, where the
+        answer depends on the elements, their tags and their children alone, never on an attribute value
+        (the schema rules' walk): the check after an edit of a value keeps it (:meth:`inherit`)."""
+        if key not in self._structure:
+            self._structure[key] = build(self.model)
+        return self._structure[key]
+
+    def link_memo(self, name: str) -> dict[Any, Any]:
+        """A dict, one per ``name`` and file, of answers about single links keyed by ``id(link)`` or a tuple
+        that starts with it: answers that depend on that link's own elements only (and the mesh files they
+        name), which the check after an edit keeps for the links it did not touch (:meth:`inherit`)."""
+        return self._link_memos.setdefault(name, {})
 
     def shared(self, key: str, build: Callable[[Model], T]) -> T:
         """``build(model)``, computed once per file for every rule that asks with the same ``key``

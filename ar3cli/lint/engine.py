@@ -26,6 +26,7 @@ from ar3cli.errors import UserError
 from ar3cli.findings import Finding, Severity
 from ar3cli.infra.file_cache import cache_dir, merge_learned, take_learned
 from ar3cli.lint.context import Context
+from ar3cli.lint.reuse import ITEM_LOCAL, Carry, Reuse, options_key
 from ar3cli.lint.rules import REGISTRY, RULES, Hit, Rule, matches
 from ar3cli.lint.rules.file import LIBRARY
 
@@ -126,6 +127,9 @@ class LintResult:
     sources: dict[str, str] = field(default_factory=dict)
     """With :attr:`LintOptions.sources`: display path -> SHA-256 of the bytes ar3cli parsed, for each
     file whose lines may be shown with a finding (:func:`shown_sources`)."""
+    carry: Carry | None = field(default=None, repr=False, compare=False)
+    """With ``lint_model(..., keep=True)``: what the static rules' run leaves for a check after an edit
+    (:mod:`ar3cli.lint.reuse`; an editor's language server keeps it)."""
 
     def to_dict(self) -> dict[str, Any]:
         return {"path": self.path, "loaded": self.loaded, "findings": len(self.findings), "error": self.error}
@@ -421,16 +425,23 @@ def unloaded_result(finding: Finding, options: LintOptions, sources: dict[str, s
     return LintResult(finding.path, False, [finding], sources=sources or {})
 
 
-def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> LintResult:
+def lint_model(model, shown: str, rules: list[Rule], options: LintOptions, reuse: Reuse | None = None,
+               keep: bool = False) -> LintResult:
     """Run ``rules`` on a loaded model and apply suppressions and severity overrides.
 
     The simulation rules run in a forked child (:func:`~ar3cli.infra.isolation.run_isolated`): when
     pybullet crashes in C on this file, the static findings stay and the crash is the file's error.
+    ``reuse``: the earlier check of a text ``model`` was edited from (the same findings, less work);
+    ``keep``: the result's :attr:`~LintResult.carry` is what the next check after an edit reuses.
     """
     if not model.links and not model.joints and is_macro_library(model):  # a xacro library: one info line (F008)
         rules = [] if matches(LIBRARY, options.ignore) else [REGISTRY[LIBRARY]]
     static, simulated, in_mujoco = _partition(rules)
-    findings, suppressed, failures = _run_rules(model, shown, static, options)
+    key = options_key(static, options)
+    carry = Carry(key, model, Context(model, options.srdf_disabled, options.targets)) if keep else None
+    if reuse is not None and not reuse.usable(model, key):
+        reuse = None
+    findings, suppressed, failures = _run_rules(model, shown, static, options, reuse, carry)
     error = None
     if simulated or in_mujoco:
         from ar3cli.infra.isolation import CrashError
@@ -455,9 +466,11 @@ def lint_model(model, shown: str, rules: list[Rule], options: LintOptions) -> Li
             findings = merge_home_contacts(findings)
     if failures and error is None:
         error = f"{shown}: {failures[0]}" + (f" (and {len(failures) - 1} more rules)" if len(failures) > 1 else "")
-    findings.sort(key=lambda f: (f.path != shown, f.path, f.line, f.column, f.rule))  # included files last
+    order = lambda f: (f.path != shown, f.path, f.line, f.column, f.rule)  # noqa: E731 - included files last
+    findings.sort(key=order)
+    suppressed.sort(key=lambda item: order(item.finding))  # the same order whatever order the rules ran in
     return LintResult(shown, True, findings, error, suppressed=suppressed,
-                      sources=shown_sources(model, shown) if options.sources else {})
+                      sources=shown_sources(model, shown) if options.sources else {}, carry=carry)
 
 
 def shown_sources(model, shown: str) -> dict[str, str]:
@@ -503,8 +516,8 @@ def _partition(rules: list[Rule]) -> tuple[list[Rule], list[Rule], list[Rule]]:
 _PARTITIONED: tuple[tuple[Rule, ...], tuple[list[Rule], list[Rule], list[Rule]]] | None = None
 
 
-def _run_rules(model, shown: str, rules: list[Rule],
-               options: LintOptions) -> tuple[list[Finding], list[Suppressed], list[str]]:
+def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions, reuse: Reuse | None = None,
+               carry: Carry | None = None) -> tuple[list[Finding], list[Suppressed], list[str]]:
     """The located findings of ``rules`` on ``model`` (unsorted), those the file's own comments
     suppress, and one line per rule that failed on this file. The configuration is applied later,
     by :func:`settle` (so the result cache holds what the file alone decides).
@@ -512,8 +525,12 @@ def _run_rules(model, shown: str, rules: list[Rule],
     A rule that raises (a value the file holds overflows a computation it did not expect, say) is a
     bug in that rule: its findings so far are kept, the other rules still run, and the file's error
     line names it, so one file never ends the batch (:func:`lint_model` makes it the file's error).
+    ``reuse`` gives the hits of item-local rules and the answers about untouched links from the earlier
+    check (:mod:`ar3cli.lint.reuse`); ``carry`` records this run's for the next.
     """
-    context = Context(model, options.srdf_disabled, options.targets)
+    context = carry.context if carry is not None else Context(model, options.srdf_disabled, options.targets)
+    if reuse is not None:
+        reuse.prepare(context)
     locator = Locator(model, shown)
     file_ignores = _file_level_ignores(model)
     findings: list[Finding] = []
@@ -524,7 +541,10 @@ def _run_rules(model, shown: str, rules: list[Rule],
             if rule.check is None:
                 continue
             try:
-                for hit in rule.check(context):
+                known = reuse.hits(rule) if reuse is not None and rule.code in ITEM_LOCAL else None
+                produced: list[Hit] = []
+                for hit in known if known is not None else rule.check(context):
+                    produced.append(hit)
                     path, line, column = locator.locate(hit)
                     finding = Finding(rule.code, rule.severity_for(options.targets), hit.message, path, line, column,
                                       hit.hint or rule.fix)
@@ -533,6 +553,8 @@ def _run_rules(model, shown: str, rules: list[Rule],
                         suppressed.append(Suppressed(finding, "comment"))
                     else:
                         findings.append(finding)
+                if carry is not None:
+                    carry.record(rule, produced)
             except (UserError, MemoryError):
                 raise
             except Exception as exc:  # noqa: BLE001 - a rule's bug: this file's error line, the batch goes on

@@ -168,7 +168,7 @@ def fix_actions(uri: str, text: str, analysis: RobotAnalysis | None, diagnostics
                 encoding: str) -> list[types.CodeAction]:
     """The quick fixes for ``diagnostics`` (those the editor asks about), and a "fix all" per fixer
     when the buffer has more than one finding it fixes; none unless ``analysis`` is of this very text."""
-    if analysis is None or analysis.model is None or analysis.model.is_xacro or \
+    if analysis is None or analysis.model is None or analysis.model.is_xacro or analysis.model.edited_away or \
             analysis.model.source_bytes != text.encode("utf-8"):
         return []
     from collections import Counter

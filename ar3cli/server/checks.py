@@ -63,7 +63,7 @@ def check(snapshot: Snapshot, settings: AnalysisSettings, earlier: Checked | Non
     from ar3cli.analysis.robot import RobotAnalysis
 
     analysis = RobotAnalysis.load(snapshot.path, settings, text=snapshot.text,
-                                  earlier=earlier.analysis if earlier is not None else None)
+                                  earlier=earlier.analysis if earlier is not None else None, editing=True)
     findings, notes = lint_findings(analysis, sim=False)
     if analysis.model is not None:
         included = analysis.model.expansion.included if analysis.model.expansion is not None else []

@@ -273,6 +273,10 @@ class Model:
     read_children: dict[Any, list[tuple[Any, Any]]] = field(default_factory=dict, repr=False, compare=False)
     """Element -> ``[(child, child.tag), ...]`` (comments included) for each element whose children the
     load read: the links and joints, and each link's inertial, visuals, collisions and their geometry."""
+    edited_away: bool = field(default=False, repr=False, compare=False)
+    """An edit of its text changed this model's tree in place and made the model of the new text from it
+    (:func:`~ar3cli.urdf.model_edit.edited`): its links and joints no longer all match the tree, and it is
+    never the base of another edit."""
 
     def children(self, element) -> list[tuple[Any, Any]]:
         """``[(child, child.tag) for child in element]``, from :attr:`read_children` when the load read them:
@@ -449,8 +453,8 @@ def load_model(
     read: dict[Any, list[tuple[Any, Any]]] = {}
     return Model(path=path, root=root, source_bytes=source, xml_bytes=xml_bytes,
                  is_xacro=is_xacro(path), resolver=resolver, quirks=quirks, expansion=expansion,
-                 links=[_read_link(element, resolver, read) for element in root.findall("link")],
-                 joints=[_read_joint(element, read) for element in root.findall("joint")], read_children=read)
+                 links=[read_link(element, resolver, read) for element in root.findall("link")],
+                 joints=[read_joint(element, read) for element in root.findall("joint")], read_children=read)
 
 
 Children = dict[Any, list[tuple[Any, Any]]]
@@ -476,7 +480,8 @@ def _first_children(element, read: Children) -> dict[Any, Any]:
     return found
 
 
-def _read_link(element, resolver: PackageResolver, read: Children) -> Link:
+def read_link(element, resolver: PackageResolver, read: Children) -> Link:
+    """The :class:`Link` of a ``<link>`` element (its children recorded in ``read``)."""
     visuals, collisions = [], []
     inertial_element = None
     for child, tag in _children(element, read):
@@ -549,7 +554,8 @@ def _read_geometry(container, resolver: PackageResolver, read: Children) -> Geom
     return Geometry(None, {"tag": kind}, element)
 
 
-def _read_joint(element, read: Children) -> Joint:
+def read_joint(element, read: Children) -> Joint:
+    """The :class:`Joint` of a ``<joint>`` element (its children recorded in ``read``)."""
     parts = _first_children(element, read)
     limit_element = parts.get("limit")
     limit = None

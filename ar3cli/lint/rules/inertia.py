@@ -440,7 +440,7 @@ def _gyration_ratio(ctx, link, mass: float | None = None) -> tuple[float, float,
     """(radius of gyration / the half-diagonal of the link's geometry box, the radius of gyration
     sqrt(I_max / m), the half-diagonal, I_max) of a valid tensor, with the file's mass (or ``mass``);
     None when there is nothing to compare. Once per link, mass and file."""
-    known = ctx.shared("gyration-ratios", lambda _model: {})
+    known = ctx.link_memo("gyration-ratios")
     key = (id(link), mass)
     if key not in known:
         known[key] = _gyration(ctx, link, mass)

@@ -105,7 +105,7 @@ def density_bounds(ctx, link) -> tuple[float | None, float | None]:
     """(highest possible density, lowest possible density) in kg/m³ from the link's collision shapes;
     each None when the shapes cannot bound it. Once per link and file (I013, its grams evidence and the
     robot's typical density all ask)."""
-    known = ctx.shared("density-bounds", lambda _model: {})
+    known = ctx.link_memo("density-bounds")
     if id(link) not in known:  # the model, and with it every link, lives as long as the context
         known[id(link)] = _density_bounds(ctx, link)
     return known[id(link)]

@@ -165,7 +165,7 @@ def _urdf_nodes(model) -> SchemaWalk:
 
 def _schema_walk(ctx) -> SchemaWalk:
     """:func:`_urdf_nodes` of the file, walked once for all the schema rules."""
-    return ctx.shared("schema-walk", _urdf_nodes)
+    return ctx.structure("schema-walk", _urdf_nodes)
 
 
 def owner(element) -> str:
