@@ -181,7 +181,54 @@ class Keystrokes:
             "contentChanges": [{"range": {"start": start, "end": end}, "text": character if typing_back else ""}]}}
 
 
-def keystroke(client: Client, keys: Keystrokes, uri: str) -> tuple[float, float, int]:
+class LineBreaks:
+    """Keystrokes that add or remove a line: Enter typed after a ``</joint>`` (another joint each time, the
+    lines kept), then, once every joint has one, those empty lines deleted again in the same order. Every
+    element below moves down or up a line, so the server loads the buffer and runs every rule in full
+    (only a keystroke inside one attribute value reuses the check before); no two texts are the same."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.joints = len(re.findall(r"</joint>", text))
+        if not self.joints:
+            raise SystemExit("the robot has no </joint> to type a line break after")
+        self.version = 1
+        self.count = 0
+
+    def next(self, uri: str) -> dict:
+        self.version += 1
+        nth = self.count % self.joints
+        adding = (self.count // self.joints) % 2 == 0
+        self.count += 1
+        end = [match.end() for match in re.finditer(r"</joint>", self.text)][nth]
+        line = self.text.count("\n", 0, end)
+        column = end - (self.text.rfind("\n", 0, end) + 1)
+        start = {"line": line, "character": column}
+        if adding:
+            self.text = self.text[:end] + "\n" + self.text[end:]
+            change = {"range": {"start": start, "end": start}, "text": "\n"}
+        else:
+            self.text = self.text[:end] + self.text[end + 1:]
+            change = {"range": {"start": start, "end": {"line": line + 1, "character": 0}}, "text": ""}
+        return {"method": "textDocument/didChange", "params": {
+            "textDocument": {"uri": uri, "version": self.version}, "contentChanges": [change]}}
+
+
+def open_server(path: Path, text: str) -> tuple[Client, float, float, int]:
+    """A server process with ``path`` open: (client, seconds to initialized, to the first diagnostics, their count)."""
+    uri = path.as_uri()
+    client = Client([*_timing.ar3cli_command(), "server", "--debounce-ms", "0"], path.parent)
+    started = time.perf_counter()
+    client.request("initialize", {"processId": os.getpid(), "rootUri": path.parent.as_uri(), "capabilities": {}})
+    client.send({"method": "initialized", "params": {}})
+    opened = client.send({"method": "textDocument/didOpen", "params": {"textDocument": {
+        "uri": uri, "languageId": "xml", "version": 1, "text": text}}})
+    first, published = client.wait(lambda m: m.get("method") == "textDocument/publishDiagnostics"
+                                   and m["params"].get("version") == 1)
+    return client, opened - started, first - opened, len(published["params"]["diagnostics"])
+
+
+def keystroke(client: Client, keys: Keystrokes | LineBreaks, uri: str) -> tuple[float, float, int]:
     """One keystroke: (wall seconds to its diagnostics, server CPU seconds meanwhile, diagnostics count)."""
     cpu = client.cpu_seconds()
     message = keys.next(uri)
@@ -212,18 +259,10 @@ def main() -> None:
     links = len(re.findall(r"<link\b", text))
     print(_timing.machine_header(f"bench_server.py: {path.name}, {links} links, {len(text) / 1024:.0f} KB"))
     uri = path.as_uri()
-    client = Client([*_timing.ar3cli_command(), "server", "--debounce-ms", "0"], path.parent)
+    client, to_initialized, to_first, findings = open_server(path, text)
     try:
-        started = time.perf_counter()
-        client.request("initialize", {"processId": os.getpid(), "rootUri": path.parent.as_uri(), "capabilities": {}})
-        client.send({"method": "initialized", "params": {}})
-        opened = client.send({"method": "textDocument/didOpen", "params": {"textDocument": {
-            "uri": uri, "languageId": "xml", "version": 1, "text": text}}})
-        first, published = client.wait(lambda m: m.get("method") == "textDocument/publishDiagnostics"
-                                       and m["params"].get("version") == 1)
-        findings = len(published["params"]["diagnostics"])
-        print(f"- server start to initialized: {opened - started:.3f} s; didOpen to its first diagnostics "
-              f"(cold: imports, first model): {first - opened:.3f} s; {findings} diagnostics\n")
+        print(f"- server start to initialized: {to_initialized:.3f} s; didOpen to its first diagnostics "
+              f"(cold: imports, first model): {to_first:.3f} s; {findings} diagnostics\n")
         keys = Keystrokes(text)
         for _ in range(args.warmup):
             keystroke(client, keys, uri)
@@ -247,29 +286,60 @@ def main() -> None:
         memory_after = client.rss_mb()
     finally:
         client.close()
-    quantiles = statistics.quantiles(walls, n=10, method="inclusive")
+    breaks = line_breaks(path, text, args.runs, args.warmup, findings)
     print(f"### keystroke to diagnostics, {links} links (debounce excluded: --debounce-ms 0)\n")
     print(f"{args.runs} rounds, each a keystroke then a lint-urdf process; medians; ratio = lint-urdf process / "
           "keystroke in the same round\n")
-    print("| what | median | min | p90 | max |\n|---|---:|---:|---:|---:|")
-    print(f"| keystroke -> publishDiagnostics, wall | {1e3 * statistics.median(walls):.1f} ms | {1e3 * min(walls):.1f} ms "
-          f"| {1e3 * quantiles[-1]:.1f} ms | {1e3 * max(walls):.1f} ms |")
-    print(f"| server CPU per keystroke | {1e3 * statistics.median(cpus):.0f} ms | {1e3 * min(cpus):.0f} ms "
-          f"| {1e3 * statistics.quantiles(cpus, n=10, method='inclusive')[-1]:.0f} ms | {1e3 * max(cpus):.0f} ms |")
+    print(timing_rows(walls, cpus))
     print(f"| `ar3cli lint-urdf --no-cache` process, wall | {1e3 * statistics.median(r.wall for r in lint.runs):.0f} ms "
           f"| {1e3 * min(r.wall for r in lint.runs):.0f} ms | | {1e3 * max(r.wall for r in lint.runs):.0f} ms |")
     print(f"\n- ratio lint-urdf process / keystroke: median {statistics.median(ratios):.1f}x "
           f"(rounds: {' '.join(f'{ratio:.1f}' for ratio in ratios)})")
     print(f"- server memory (VmRSS): {memory_before:.0f} MB after the timed rounds, {memory_after:.0f} MB after "
           f"{args.memory_edits} more keystrokes")
+    print(f"\n### a keystroke that adds or removes a line ({args.runs} rounds, another server process)\n")
+    print("Enter typed after a `</joint>`, or that empty line deleted: every later element moves, so the server "
+          "checks the buffer in full\n")
+    print(timing_rows(*zip(*breaks)))
     print(breakdown(path, text, args.runs))
     print(_timing.machine_footer())
 
 
+def timing_rows(walls, cpus) -> str:
+    """The table head and the wall and CPU rows (median, min, p90, max) of some keystrokes."""
+    def p90(values) -> float:
+        return statistics.quantiles(values, n=10, method="inclusive")[-1]
+
+    return "\n".join([
+        "| what | median | min | p90 | max |", "|---|---:|---:|---:|---:|",
+        f"| keystroke -> publishDiagnostics, wall | {1e3 * statistics.median(walls):.1f} ms | {1e3 * min(walls):.1f} ms "
+        f"| {1e3 * p90(walls):.1f} ms | {1e3 * max(walls):.1f} ms |",
+        f"| server CPU per keystroke | {1e3 * statistics.median(cpus):.0f} ms | {1e3 * min(cpus):.0f} ms "
+        f"| {1e3 * p90(cpus):.0f} ms | {1e3 * max(cpus):.0f} ms |"])
+
+
+def line_breaks(path: Path, text: str, runs: int, warmup: int, findings: int) -> list[tuple[float, float]]:
+    """(wall, server CPU) of ``runs`` line-break keystrokes (:class:`LineBreaks`) in a server of their own."""
+    client, _initialized, _first, _count = open_server(path, text)
+    try:
+        keys = LineBreaks(text)
+        for _ in range(warmup):
+            keystroke(client, keys, path.as_uri())
+        timed = []
+        for _ in range(runs):
+            wall, cpu, count = keystroke(client, keys, path.as_uri())
+            if count != findings:
+                raise SystemExit(f"a line break gave {count} diagnostics, the file {findings}: not the same check")
+            timed.append((wall, cpu))
+        return timed
+    finally:
+        client.close()
+
+
 def breakdown(path: Path, text: str, runs: int) -> str:
-    """Where a keystroke's CPU goes, measured in this process on the same text (not a speed claim: the
-    whole-process numbers above are): the buffer loaded into a model, lint-urdf's static rules on it,
-    the findings turned into diagnostics."""
+    """Where a check's CPU goes, measured in this process on the same robot (not a speed claim: the
+    whole-process numbers above are): the buffer loaded into a model, lint-urdf's static rules on it, the
+    findings turned into diagnostics; for a full check and for a keystroke in one value checked after it."""
     sys.path.insert(0, str(_timing.REPO))
     import gc
 
@@ -283,23 +353,43 @@ def breakdown(path: Path, text: str, runs: int) -> str:
     gc.collect()
     gc.freeze()  # as the server does once it has imported what a check needs (ar3cli.server.launch)
     settings = AnalysisSettings()
-    steps: dict[str, list[float]] = {"load the buffer (parse, model)": [], "lint-urdf's static rules": [],
-                                     "findings to diagnostics (ranges)": []}
+    names = ("load the buffer (parse, model)", "lint-urdf's static rules", "findings to diagnostics (ranges)")
+    steps: dict[str, dict[str, list[float]]] = {"full": {name: [] for name in names},
+                                                "edited": {name: [] for name in names}}
+    keys = Keystrokes(text)
+    earlier, current = None, text
     for index in range(runs + 2):
-        changed = text + " " * index  # a new buffer each time, as a keystroke makes
-        start = time.process_time()
-        analysis = RobotAnalysis.load(path, settings, text=changed)
-        loaded = time.process_time()
-        found = static_findings(analysis).findings
-        linted = time.process_time()
-        diagnostics_by_file(found, analysis, Snapshot(path.as_uri(), path, index, changed), "utf-16")
-        done = time.process_time()
-        if index >= 2:  # the first two warm up imports and caches
-            for name, seconds in zip(steps, (loaded - start, linted - loaded, done - linted)):
-                steps[name].append(seconds)
-    lines = ["", f"in-process breakdown of one check (CPU time, median of {runs}; this process, same text):", "",
-             "| step | CPU ms |", "|---|---:|"]
-    lines += [f"| {name} | {1e3 * statistics.median(values):.1f} |" for name, values in steps.items()]
+        for kind in ("full", "edited"):
+            if kind == "full":
+                changed = current + " " * (index + 1)  # a new buffer, not one value's edit: loaded in full
+            else:
+                change = keys.next(path.as_uri())["params"]["contentChanges"][0]
+                line, column = change["range"]["start"]["line"], change["range"]["start"]["character"]
+                offset = sum(len(row) + 1 for row in current.split("\n")[:line]) + column
+                removed = change["range"]["end"]["character"] - column
+                current = current[:offset] + change["text"] + current[offset + removed:]
+                changed = current + " " * (index + 1)  # the full check's buffer with the keystroke
+            start = time.process_time()
+            analysis = RobotAnalysis.load(path, settings, text=changed, earlier=earlier, editing=True)
+            loaded = time.process_time()
+            found = static_findings(analysis).findings
+            linted = time.process_time()
+            diagnostics_by_file(found, analysis, Snapshot(path.as_uri(), path, index, changed), "utf-16")
+            done = time.process_time()
+            if kind == "edited" and analysis.edit is None:
+                raise SystemExit("the breakdown's keystroke was not checked as an edit of the one before")
+            earlier = analysis
+            if index >= 2:  # the first two warm up imports and caches
+                for name, seconds in zip(names, (loaded - start, linted - loaded, done - linted)):
+                    steps[kind][name].append(seconds)
+    lines = ["", f"in-process breakdown of one check (CPU time, median of {runs}; this process, same robot): a full "
+             "check (a new buffer, loaded and linted in full) and a keystroke in one value checked after the one "
+             "before, as the server does", "", "| step | full check, CPU ms | keystroke in a value, CPU ms |",
+             "|---|---:|---:|"]
+    lines += [f"| {name} | {1e3 * statistics.median(steps['full'][name]):.1f} "
+              f"| {1e3 * statistics.median(steps['edited'][name]):.1f} |" for name in names]
+    lines.append(f"| all | {1e3 * sum(statistics.median(v) for v in steps['full'].values()):.1f} "
+                 f"| {1e3 * sum(statistics.median(v) for v in steps['edited'].values()):.1f} |")
     return "\n".join(lines) + "\n" + rule_costs(analysis, runs)
 
 

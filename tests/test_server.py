@@ -301,3 +301,39 @@ async def test_hostile_names_reach_the_editor_as_plain_text(client: LanguageClie
     assert len(names) >= 3 and any("::error file=x::" in name for name in names)  # the names are there, escaped
     for text in shown:
         assert not any(character in text for character in RAW), repr(text)
+
+
+@pytest.mark.asyncio(loop_scope="module")
+async def test_keystrokes_in_a_value_give_what_lint_urdf_and_the_fixers_give_on_the_typed_text(
+        client: LanguageClient, workspace: Path):
+    """One character at a time, as an editor sends them: the server checks each as an edit of the last
+    buffer (the model patched, the earlier check's work reused) and must say what a fresh lint-urdf says."""
+    path = workspace / "arm" / "arm.urdf"
+    uri, text = path.as_uri(), path.read_text()
+    await diagnostics(client, uri, lambda found: "J003" in codes(found))
+    line = text.splitlines().index('    <limit lower="1.5" upper="-1.5" effort="10" velocity="1"/>')
+    column = text.splitlines()[line].index('"-1.5"') + 1
+    typed = text
+    for version, (start, end, new) in enumerate([(column, column + 1, ""), (column + 3, column + 3, "9")], 20):
+        client.text_document_did_change(types.DidChangeTextDocumentParams(
+            types.VersionedTextDocumentIdentifier(version, uri), [types.TextDocumentContentChangePartial(
+                types.Range(types.Position(line, start), types.Position(line, end)), new)]))
+        lines = typed.splitlines(keepends=True)
+        lines[line] = lines[line][:start] + new + lines[line][end:]
+        typed = "".join(lines)
+    assert 'upper="1.59"' in typed
+    found = await diagnostics(client, uri, lambda found: not codes(found) & {"J003", "J004"})
+    copy = path.parent / "typed.urdf"
+    copy.write_text(typed)
+    try:
+        cli = json.loads(run_cli("lint-urdf", "arm/typed.urdf", "--format", "json", "--no-cache", cwd=workspace).stdout)
+        assert {(str(item.code), item.range.start.line, item.message.split("\n")[0]) for item in found} == \
+            {(finding["rule"], finding["line"] - 1, finding["message"]) for finding in cli["findings"]}
+        action = next(action for action in await actions_for(client, uri, next(item for item in found if item.code == "J006"))
+                      if action.title.startswith("fix-continuous"))
+        assert run_cli("fix-continuous", str(copy), "--no-verify").code == 0
+        assert apply_edits(typed, action.edit.changes[uri]) == copy.read_text()
+    finally:
+        copy.unlink()
+    replace_all(client, uri, text, 30)
+    await diagnostics(client, uri, lambda found: "J003" in codes(found))
