@@ -14,7 +14,9 @@ rules) and the way ``lint-urdf`` does (a fresh load), and compares lint-urdf's w
   of the file gives the same attribute (another link's name, which makes a duplicate; another joint's
   type or parent), the edits whose effect reaches beyond the edited element;
 - in any attribute of the file: a joint limit, an origin, a mass, a mesh filename, a link or joint name,
-  a joint type, a material colour, a ``<robot>`` attribute.
+  a joint type, a material colour, a ``<robot>`` attribute;
+- or, one keystroke in five, between elements (Enter, an indent, a tab, or a line break or space deleted:
+  every element below moves), and one in twenty inside a comment.
 
 Per corpus: the files, the keystrokes, how many took the fast path (the model made from the earlier one),
 how many a full load, and the keystrokes whose findings differ (each one printed, with the edit).
@@ -45,6 +47,8 @@ sys.path.insert(0, str(REPO))
 
 ATTRIBUTE_VALUE = re.compile(r"""\s([\w:.\-]+)\s*=\s*(?:"([^"]*)"|'([^']*)')""")
 TYPED = "0123456789.-e" + "0123456789" + "abcxyz_ " + "<\"&\n"
+BETWEEN = re.compile(r">(\s)")
+COMMENT = re.compile(r"<!--()")
 PASTED = ("0", "1.5707963", "-3.14", "1e-3", "0.001 0 0", "0 0 1", "10", "nan", "base_link", "fixed", "revolute",
           "continuous", "prismatic", "world", "package://nowhere/x.stl", "", "1 1 1 1", "255 128 0 1")
 
@@ -60,6 +64,24 @@ def keystrokes(text: str, count: int, seed: int) -> Iterator[tuple[str, str]]:
             return
         name, start, end = chooser.choice(values)
         line = text.count("\n", 0, start) + 1
+        action = chooser.random()
+        between = [match.start(1) for match in BETWEEN.finditer(text)]
+        if action < 0.2 and between:  # Enter, an indent, a line joined: between elements
+            at = chooser.choice(between)
+            line = text.count("\n", 0, at) + 1
+            if chooser.random() < 0.5:
+                typed = chooser.choice(("\n", "  ", "\t", "\n    "))
+                text, what = text[:at] + typed + text[at:], f"line {line}: typed {typed!r} between elements"
+            else:
+                text, what = text[:at] + text[at + 1:], f"line {line}: deleted {text[at]!r} between elements"
+            yield text, what
+            continue
+        comments = [match.start(1) for match in COMMENT.finditer(text)]
+        if action < 0.25 and comments:
+            at = chooser.choice(comments)
+            text, what = text[:at] + "x" + text[at:], f"line {text.count(chr(10), 0, at) + 1}: typed 'x' in a comment"
+            yield text, what
+            continue
         action = chooser.random()
         if action < 0.15:  # another element's value of this attribute: a duplicate name, another link, a type
             pasted = chooser.choice([text[a:b] for other, a, b in values if other == name])

@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING, Any
 
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules.base import Hit
-from ar3cli.urdf.model import Link, read_joint, read_link
+from ar3cli.urdf.model import read_joint, read_link
 
 if TYPE_CHECKING:
     from ar3cli.lint.rules.base import Rule
@@ -85,8 +85,7 @@ class Reuse:
 
     carry: Carry
     edit: Edit
-    _item_model: tuple[Model, Any] | None = None
-    _item_context: Context | None = None
+    _alone: dict[int, tuple[tuple[Model, Any], Context]] = field(default_factory=dict)
 
     def usable(self, model: Model, key: tuple) -> bool:
         """Whether this reuse belongs to a run on ``model`` with rules and options ``key``."""
@@ -95,30 +94,29 @@ class Reuse:
     def prepare(self, context: Context) -> None:
         """Give ``context`` the earlier context's answers about the links the edit did not touch."""
         edit = self.edit
-        kept = [link for link in edit.model.links if link is not edit.after]
-        dropped = {edit.before.name, edit.after.name} if isinstance(edit.after, Link) else set()
-        context.inherit(self.carry.context, kept, dropped)
+        read_again = {id(thing) for thing in edit.after}
+        context.inherit(self.carry.context, [link for link in edit.model.links if id(link) not in read_again])
 
     def hits(self, rule: Rule) -> list[Hit] | None:
-        """``rule``'s hits on the edited model from the earlier ones and a check of the edited item alone;
-        None when the rule must run in full (not item-local, not kept, or a hit of the item's check that is
+        """``rule``'s hits on the edited model from the earlier ones and a check of each changed item alone;
+        None when the rule must run in full (not item-local, not kept, or a hit of an item's check that is
         not inside the item)."""
         earlier = self.carry.hits.get(rule.code)
         if earlier is None or rule.check is None:
             return None
-        item = self.edit.item
-        own = self._item_hits(rule)
-        if own is None:
-            return None
-        found = [hit for element, hits in earlier.items() if element is not item for hit in hits]
-        return found + own
-
-    def _item_hits(self, rule: Rule) -> list[Hit] | None:
-        if self._item_model is None:
-            self._item_model = item_model(self.edit.model, self.edit.item)
-            self._item_context = Context(self._item_model[0], self.carry.context.srdf_disabled,
-                                         self.carry.context.targets)
-        return item_hits(rule, self._item_model, self._item_context, self.edit.item)  # type: ignore[arg-type]
+        changed = {id(item) for item in self.edit.items}
+        found = [hit for element, hits in earlier.items() if id(element) not in changed for hit in hits]
+        for item in self.edit.items:
+            if id(item) not in self._alone:
+                alone = item_model(self.edit.model, item)
+                self._alone[id(item)] = (alone, Context(alone[0], self.carry.context.srdf_disabled,
+                                                        self.carry.context.targets))
+            alone, context = self._alone[id(item)]
+            own = item_hits(rule, alone, context, item)
+            if own is None:
+                return None
+            found += own
+        return found
 
 
 def item_hits(rule: Rule, alone: tuple[Model, Any], context: Context, item: Any) -> list[Hit] | None:

@@ -1,22 +1,26 @@
-"""A keystroke applied to a loaded model: the new text's model without parsing the file again.
+"""A keystroke applied to a loaded model: the new text's model, sharing every object the edit did not touch.
 
-An editor sends a new buffer on every keystroke, and nearly every keystroke changes one attribute
-value of one element (``upper="1.57"`` -> ``upper="1.5"``). :func:`edited` recognises exactly that
-case in the bytes and answers with the model of the new text built from the earlier one: the
-attribute is set on the element the earlier parse made, the one ``<link>`` or ``<joint>`` holding
-it is read again, and every other element, link, joint, shape and child list is the same object as
-before. That is what a parse of the new text would give (the same tree, the same source lines:
-the edit adds no line), for a fraction of its cost, and it lets the next check reuse what it knew
-about the objects the edit did not touch (:mod:`ar3cli.lint.reuse`).
+An editor sends a new buffer on every keystroke, and nearly every keystroke changes one attribute value
+(``upper="1.57"`` -> ``upper="1.5"``), a line break or an indent, or one element's content. :func:`edited`
+makes the model of the new text from the earlier one, in one of two ways:
 
-Anything else is None, and the caller parses the new text as usual: an edit outside an attribute
-value or spanning several, a value holding an entity reference, a tab or a line break (the parser
-rewrites those), markup characters typed, an edit inside a comment, CDATA or processing
-instruction, a file with a DOCTYPE or any load quirk (BOM, CRLF, junk, another encoding), an
-element that cannot be told apart from another on its line, an attribute with a namespace, a mesh's
-``filename`` (a full load resolves it with a fresh resolver, which does not keep every name typed on the
-way), an element outside the robot's links and joints, and xacro files (the buffer is not what was parsed).
-The earlier model is consumed: its tree now holds the new value, so it is never the base of
+- **One attribute value** of one element inside a ``<link>`` or ``<joint>`` (found in the bytes, no parse):
+  the attribute is set on the element the earlier parse made and that link or joint is read again.
+- **The same elements** (a line added or removed, an indent, values or comments changed anywhere inside
+  the items, several of them): the new text is parsed, and when its tree has the same nodes with the same
+  tags as the earlier one and ``<robot>`` keeps its attributes, the new source lines, texts and attributes
+  are copied into the earlier tree, and the links and joints whose content changed are read again.
+
+Either way every other element, link, joint, shape and child list stays the same object, and the model is
+the one a load of the new text gives (the same tree, source lines, links and joints): that is what lets the
+next check reuse what it knew about the objects the edit did not touch (:mod:`ar3cli.lint.reuse`).
+
+Anything else is None, and the caller loads the new text as usual: a new, removed or renamed element, a
+change of ``<robot>``'s attributes, a mesh's ``filename`` (a full load resolves it with a fresh resolver,
+which does not keep every name typed on the way), a namespace declared or changed below ``<robot>``, a
+processing instruction in a changed item, a DOCTYPE, CDATA or any load quirk (BOM, CRLF, junk, another
+encoding, an undeclared prefix), a text that does not parse, and xacro files (the buffer is not what was
+parsed). The earlier model is consumed: its tree now holds the new text, so it is never the base of
 another edit (:attr:`Model.edited_away`; :attr:`Edit.model` is the base of the next).
 """
 
@@ -43,25 +47,57 @@ class Edit:
     """The model of a new text made from the earlier one, and what the edit touched."""
 
     model: Model
-    item: Any
-    """The ``<link>`` or ``<joint>`` element (a child of ``<robot>``) holding the edited attribute: the same
-    element object in the earlier model and in :attr:`model`."""
-    before: Link | Joint
-    """The item's object in the earlier model (read before the edit)."""
-    after: Link | Joint
-    """The item's object in :attr:`model`."""
+    items: tuple[Any, ...]
+    """The children of ``<robot>`` (links, joints, materials, comments...) whose content changed: the same
+    element objects in the earlier model and in :attr:`model`. Empty for a line break or an indent."""
+    before: tuple[Link | Joint, ...]
+    """The changed links' and joints' objects in the earlier model."""
+    after: tuple[Link | Joint, ...]
+    """Their objects in :attr:`model`, read again."""
 
 
 def edited(model: Model, source: bytes) -> Edit | None:
-    """The model of ``source`` made from ``model`` when ``source`` differs from the model's text by one
-    attribute value of one link or joint (the tree of ``model`` is changed in place, and ``model`` may not
-    be edited again); None otherwise (``model`` untouched)."""
+    """The model of ``source`` made from ``model`` (whose tree changes in place, and which may not be edited
+    again) when the edit is one this module takes; None otherwise, ``model`` untouched."""
     if model.is_xacro or model.quirks or model.edited_away or model.xml_bytes != model.source_bytes:
         return None
-    old = model.source_bytes
-    if source == old or b"<!DOCTYPE" in source or b"<![CDATA[" in source or b"\r" in source or b"\x00" in source \
-            or source.startswith(b"\xef\xbb\xbf"):
+    if source == model.source_bytes or b"<!DOCTYPE" in source or b"<![CDATA[" in source or b"\r" in source \
+            or b"\x00" in source or source.startswith(b"\xef\xbb\xbf"):
         return None
+    found = _one_value(model, source)
+    if found is None:
+        found = _same_elements(model, source)
+    if found is None:
+        return None
+    changed, objects = found
+    model.edited_away = True
+    before, after, kinds = [], [], {"link": list(model.links), "joint": list(model.joints)}
+    for item in changed:
+        objects_of_kind = kinds.get(item.tag)
+        index = objects.get(id(item))
+        if objects_of_kind is None or index is None:
+            continue
+        before.append(objects_of_kind[index])
+        objects_of_kind[index] = read_link(item, model.resolver, model.read_children) if item.tag == "link" \
+            else read_joint(item, model.read_children)
+        after.append(objects_of_kind[index])
+    new_model = replace(model, source_bytes=source, xml_bytes=source, quirks=[], edited_away=False,
+                        links=kinds["link"], joints=kinds["joint"])
+    return Edit(new_model, tuple(changed), tuple(before), tuple(after))
+
+
+Found = tuple[list[Any], dict[int, int]]
+"""(the changed children of ``<robot>``, and id of each link or joint element -> its index in its list)."""
+
+
+def _indexes(model: Model) -> dict[int, int]:
+    return {id(thing.element): index for things in (model.links, model.joints) for index, thing in enumerate(things)}
+
+
+def _one_value(model: Model, source: bytes) -> Found | None:
+    """One attribute value of one element inside a link or joint changed: set it (the tree is changed only
+    when this answers)."""
+    old = model.source_bytes
     start, old_end, new_end = _changed_span(old, source)
     if not (_plain(old[start:old_end]) and _plain(source[start:new_end])):
         return None
@@ -80,21 +116,67 @@ def edited(model: Model, source: bytes) -> Edit | None:
     item = element
     while item.getparent() is not None and item.getparent() is not model.root:
         item = item.getparent()
-    kind = "links" if item.tag == "link" else "joints" if item.tag == "joint" else None
-    if kind is None or item.getparent() is not model.root:
-        return None
-    objects = getattr(model, kind)
-    index = next((i for i, thing in enumerate(objects) if thing.element is item), None)
-    if index is None:
+    objects = _indexes(model)
+    if item.getparent() is not model.root or id(item) not in objects:
         return None
     element.set(name.decode("utf-8"), new_value.decode("utf-8"))
-    model.edited_away = True
-    read = model.read_children
-    after = read_link(item, model.resolver, read) if kind == "links" else read_joint(item, read)
-    changed = list(objects)
-    changed[index] = after
-    new_model = replace(model, source_bytes=source, xml_bytes=source, quirks=[], edited_away=False, **{kind: changed})
-    return Edit(new_model, item, objects[index], after)
+    return [item], objects
+
+
+def _same_elements(model: Model, source: bytes) -> Found | None:
+    """The new text's tree has the earlier one's nodes and tags: copy its source lines, and the texts and
+    attributes of the items whose content changed, into the earlier tree (changed only when this answers)."""
+    from lxml import etree
+
+    from ar3cli.errors import UserError
+    from ar3cli.urdf import xmlsource
+
+    try:
+        normalized, quirks = xmlsource.normalize(source)
+        xmlsource.refuse_entities(source, model.path)
+        root, parse_quirks = xmlsource.parse(normalized, model.path)
+    except (UserError, RecursionError):
+        return None
+    old_root = model.root
+    if quirks or parse_quirks or normalized != source or root.tag != old_root.tag or root.nsmap != old_root.nsmap \
+            or dict(root.attrib) != dict(old_root.attrib) or list(root.keys()) != list(old_root.keys()):
+        return None
+    if _outside(old_root) != _outside(root):
+        return None  # a comment before or after <robot> changed
+    old_nodes, new_nodes = list(old_root.iter()), list(root.iter())
+    if len(old_nodes) != len(new_nodes) or any(a.tag != b.tag for a, b in zip(old_nodes, new_nodes)):
+        return None
+    changed = []
+    for old_item, new_item in zip(old_root, root):
+        if etree.tostring(old_item, with_tail=False) == etree.tostring(new_item, with_tail=False):
+            continue
+        pairs = list(zip(old_item.iter(), new_item.iter()))
+        if any(a.nsmap != b.nsmap or isinstance(a, etree._ProcessingInstruction) for a, b in pairs) \
+                or [a.get("filename") for a in old_item.iter("mesh")] != [b.get("filename") for b in new_item.iter("mesh")]:
+            return None
+        changed.append((old_item, pairs))
+    for a, b in zip(old_nodes, new_nodes):
+        if a.sourceline != b.sourceline:
+            a.sourceline = b.sourceline
+    old_root.text = root.text
+    for old_item, new_item in zip(old_root, root):
+        old_item.tail = new_item.tail
+    for _item, pairs in changed:
+        for a, b in pairs:
+            a.text, a.tail = b.text, b.tail
+            if isinstance(a.tag, str) and list(a.items()) != list(b.items()):
+                a.attrib.clear()
+                for key, value in b.items():
+                    a.set(key, value)
+    return [item for item, _pairs in changed], _indexes(model)
+
+
+def _outside(root: Any) -> list[bytes]:
+    """The nodes before and after ``<robot>`` (comments, processing instructions), serialised."""
+    from lxml import etree
+
+    return [etree.tostring(node) if node is not None else b"<robot/>"  # where <robot> is
+            for node in (*root.itersiblings(preceding=True), None, *root.itersiblings())]
 
 
 def _changed_span(old: bytes, new: bytes) -> tuple[int, int, int]:
