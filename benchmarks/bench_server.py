@@ -11,6 +11,13 @@ is excluded (``--debounce-ms 0``): with the default (150 ms) an editor sees the 
 plus this after the last keystroke of a burst. The server's CPU time per keystroke is read from
 ``/proc/PID/stat`` (Linux), since on a shared machine wall time includes waiting for a core.
 
+A keystroke in a value is what the server checks fastest: it makes the new model from the one it has
+and reuses the earlier check's work (``ar3cli/urdf/model_edit.py``, ``ar3cli/lint/reuse.py``). Two more
+kinds are timed, each in a server process of its own (:data:`KINDS`): a line break typed after a
+``</joint>`` or deleted (every element below moves: the buffer is parsed and its new lines copied into the
+model), and an element pasted or deleted (a full load, every rule). Last, an in-process breakdown of a
+full check and of a keystroke in a value (load, rules, diagnostics).
+
 Alternating with each keystroke, the same file is linted by a whole ``ar3cli lint-urdf --no-cache``
 process (what a save hook or a terminal pays, interpreter start-up included), and the ratio is taken
 round by round. Before the timed rounds: the first diagnostics after ``didOpen`` (cold: imports,
@@ -181,17 +188,18 @@ class Keystrokes:
             "contentChanges": [{"range": {"start": start, "end": end}, "text": character if typing_back else ""}]}}
 
 
-class LineBreaks:
-    """Keystrokes that add or remove a line: Enter typed after a ``</joint>`` (another joint each time, the
-    lines kept), then, once every joint has one, those empty lines deleted again in the same order. Every
-    element below moves down or up a line, so the server loads the buffer and runs every rule in full
-    (only a keystroke inside one attribute value reuses the check before); no two texts are the same."""
+class Insertions:
+    """Keystrokes that insert ``inserted`` at each ``</joint>`` (after it, or before it with ``before``), another
+    joint each time and the insertions kept, then, once every joint has one, delete them again in the same
+    order: no two texts are the same. A line break after ``</joint>`` moves every element below it (the server
+    parses the buffer and copies the new lines into the model it has); an element pasted before it adds an
+    element (the server loads the buffer and runs every rule in full)."""
 
-    def __init__(self, text: str) -> None:
-        self.text = text
+    def __init__(self, text: str, inserted: str, before: bool = False) -> None:
+        self.text, self.inserted, self.before = text, inserted, before
         self.joints = len(re.findall(r"</joint>", text))
         if not self.joints:
-            raise SystemExit("the robot has no </joint> to type a line break after")
+            raise SystemExit("the robot has no </joint> to type at")
         self.version = 1
         self.count = 0
 
@@ -200,18 +208,28 @@ class LineBreaks:
         nth = self.count % self.joints
         adding = (self.count // self.joints) % 2 == 0
         self.count += 1
-        end = [match.end() for match in re.finditer(r"</joint>", self.text)][nth]
-        line = self.text.count("\n", 0, end)
-        column = end - (self.text.rfind("\n", 0, end) + 1)
-        start = {"line": line, "character": column}
+        where = [match.start() if self.before else match.end() for match in re.finditer(r"</joint>", self.text)][nth]
+        at = where - len(self.inserted) if self.before and not adding else where
+        start = self.position(at)
         if adding:
-            self.text = self.text[:end] + "\n" + self.text[end:]
-            change = {"range": {"start": start, "end": start}, "text": "\n"}
+            self.text = self.text[:at] + self.inserted + self.text[at:]
+            change = {"range": {"start": start, "end": start}, "text": self.inserted}
         else:
-            self.text = self.text[:end] + self.text[end + 1:]
-            change = {"range": {"start": start, "end": {"line": line + 1, "character": 0}}, "text": ""}
+            change = {"range": {"start": start, "end": self.position(at + len(self.inserted))}, "text": ""}
+            self.text = self.text[:at] + self.text[at + len(self.inserted):]
         return {"method": "textDocument/didChange", "params": {
             "textDocument": {"uri": uri, "version": self.version}, "contentChanges": [change]}}
+
+    def position(self, offset: int) -> dict:
+        """The LSP position of ``offset`` in the current text (ASCII: characters are UTF-16 units)."""
+        return {"line": self.text.count("\n", 0, offset), "character": offset - (self.text.rfind("\n", 0, offset) + 1)}
+
+
+KINDS = {"a line break after a `</joint>`, or that empty line deleted (every later element moves: the buffer is "
+         "parsed, its new lines copied into the model the server has)": ("\n", False),
+         "a `<dynamics damping=\"0.1\"/>` pasted before a `</joint>`, or deleted (an element more or less: a full "
+         "load and every rule)": ('<dynamics damping="0.1"/>', True)}
+"""The keystrokes timed besides those in a value: what they do, and (inserted text, before ``</joint>``)."""
 
 
 def open_server(path: Path, text: str) -> tuple[Client, float, float, int]:
@@ -228,7 +246,7 @@ def open_server(path: Path, text: str) -> tuple[Client, float, float, int]:
     return client, opened - started, first - opened, len(published["params"]["diagnostics"])
 
 
-def keystroke(client: Client, keys: Keystrokes | LineBreaks, uri: str) -> tuple[float, float, int]:
+def keystroke(client: Client, keys: Keystrokes | Insertions, uri: str) -> tuple[float, float, int]:
     """One keystroke: (wall seconds to its diagnostics, server CPU seconds meanwhile, diagnostics count)."""
     cpu = client.cpu_seconds()
     message = keys.next(uri)
@@ -286,7 +304,7 @@ def main() -> None:
         memory_after = client.rss_mb()
     finally:
         client.close()
-    breaks = line_breaks(path, text, args.runs, args.warmup, findings)
+    others = {what: insertions(path, text, args.runs, args.warmup, findings, *how) for what, how in KINDS.items()}
     print(f"### keystroke to diagnostics, {links} links (debounce excluded: --debounce-ms 0)\n")
     print(f"{args.runs} rounds, each a keystroke then a lint-urdf process; medians; ratio = lint-urdf process / "
           "keystroke in the same round\n")
@@ -297,10 +315,9 @@ def main() -> None:
           f"(rounds: {' '.join(f'{ratio:.1f}' for ratio in ratios)})")
     print(f"- server memory (VmRSS): {memory_before:.0f} MB after the timed rounds, {memory_after:.0f} MB after "
           f"{args.memory_edits} more keystrokes")
-    print(f"\n### a keystroke that adds or removes a line ({args.runs} rounds, another server process)\n")
-    print("Enter typed after a `</joint>`, or that empty line deleted: every later element moves, so the server "
-          "checks the buffer in full\n")
-    print(timing_rows(*zip(*breaks)))
+    for what, timed in others.items():
+        print(f"\n### {what}\n\n{args.runs} rounds, another server process\n")
+        print(timing_rows(*zip(*timed)))
     print(breakdown(path, text, args.runs))
     print(_timing.machine_footer())
 
@@ -318,18 +335,20 @@ def timing_rows(walls, cpus) -> str:
         f"| {1e3 * p90(cpus):.0f} ms | {1e3 * max(cpus):.0f} ms |"])
 
 
-def line_breaks(path: Path, text: str, runs: int, warmup: int, findings: int) -> list[tuple[float, float]]:
-    """(wall, server CPU) of ``runs`` line-break keystrokes (:class:`LineBreaks`) in a server of their own."""
+def insertions(path: Path, text: str, runs: int, warmup: int, findings: int, inserted: str,
+               before: bool) -> list[tuple[float, float]]:
+    """(wall, server CPU) of ``runs`` :class:`Insertions` keystrokes in a server of their own."""
     client, _initialized, _first, _count = open_server(path, text)
     try:
-        keys = LineBreaks(text)
+        keys = Insertions(text, inserted, before)
         for _ in range(warmup):
             keystroke(client, keys, path.as_uri())
         timed = []
         for _ in range(runs):
             wall, cpu, count = keystroke(client, keys, path.as_uri())
             if count != findings:
-                raise SystemExit(f"a line break gave {count} diagnostics, the file {findings}: not the same check")
+                raise SystemExit(f"a keystroke ({inserted!r}) gave {count} diagnostics, the file {findings}: "
+                                 "not the same check")
             timed.append((wall, cpu))
         return timed
     finally:
@@ -361,7 +380,7 @@ def breakdown(path: Path, text: str, runs: int) -> str:
     for index in range(runs + 2):
         for kind in ("full", "edited"):
             if kind == "full":
-                changed = current + " " * (index + 1)  # a new buffer, not one value's edit: loaded in full
+                changed = current + " " * (index + 1)  # a new buffer
             else:
                 change = keys.next(path.as_uri())["params"]["contentChanges"][0]
                 line, column = change["range"]["start"]["line"], change["range"]["start"]["character"]
@@ -370,7 +389,8 @@ def breakdown(path: Path, text: str, runs: int) -> str:
                 current = current[:offset] + change["text"] + current[offset + removed:]
                 changed = current + " " * (index + 1)  # the full check's buffer with the keystroke
             start = time.process_time()
-            analysis = RobotAnalysis.load(path, settings, text=changed, earlier=earlier, editing=True)
+            analysis = RobotAnalysis.load(path, settings, text=changed, earlier=earlier if kind == "edited" else None,
+                                          editing=True)  # no earlier analysis: a full check
             loaded = time.process_time()
             found = static_findings(analysis).findings
             linted = time.process_time()

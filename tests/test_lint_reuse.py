@@ -234,3 +234,27 @@ def test_two_links_of_one_name_are_each_judged_on_their_own_shapes(tmp_path):
     path, model = _load(tmp_path, text)
     found = [hit.message for hit in next(rule for rule in RULES if rule.code == "I007").check(Context(model))]
     assert len(found) == 1 and "half-diagonal 0.0173 m" in found[0]  # the small one; the first was judged plausible
+
+
+def test_findings_at_one_place_come_in_one_order_after_a_keystroke(tmp_path):
+    """Two links on one line share their <inertia>'s column (the first on the line): the edited one's finding
+    is found last after a keystroke, first in a full check; the message orders them both the same way."""
+    from ar3cli.analysis.findings import static_findings
+    from ar3cli.analysis.robot import RobotAnalysis
+    from ar3cli.analysis.settings import AnalysisSettings
+
+    flat = '<inertial><mass value="1"/><inertia ixx="0.001" ixy="0" ixz="0" iyy="0.001" iyz="0" izz="{}"/></inertial>'
+    text = (f'<robot name="r">\n  <link name="a">{flat.format(1)}</link><link name="b">{flat.format(0.5)}</link>\n'
+            '  <joint name="j" type="fixed"><parent link="a"/><child link="b"/></joint>\n</robot>\n')
+    path = tmp_path / "r.urdf"
+    settings = AnalysisSettings()
+    earlier = RobotAnalysis.load(path, settings, text, editing=True)
+    static_findings(earlier)
+    typed = text.replace('izz="1"', 'izz="2"')
+    edited_check = RobotAnalysis.load(path, settings, typed, earlier=earlier, editing=True)
+    assert edited_check.edit is not None
+    found = [(finding.line, finding.column, finding.rule, finding.message) for finding in static_findings(edited_check).findings]
+    assert found == [(finding.line, finding.column, finding.rule, finding.message)
+                     for finding in static_findings(RobotAnalysis.load(path, settings, typed)).findings]
+    assert [message for _line, _column, rule, message in found if rule == "I005"] == sorted(
+        message for _line, _column, rule, message in found if rule == "I005") and len(found) >= 2

@@ -125,7 +125,11 @@ def _one_value(model: Model, source: bytes) -> Found | None:
 
 def _same_elements(model: Model, source: bytes) -> Found | None:
     """The new text's tree has the earlier one's nodes and tags: copy its source lines, and the texts and
-    attributes of the items whose content changed, into the earlier tree (changed only when this answers)."""
+    attributes of the items whose content changed, into the earlier tree (changed only when this answers).
+
+    Only the bytes between the common start and the common end of the two texts changed, so a child of
+    ``<robot>`` wholly before them is the same and one wholly after them the same, moved by the lines the
+    edit added; only the few children whose lines reach the changed ones are compared node by node."""
     from lxml import etree
 
     from ar3cli.errors import UserError
@@ -137,38 +141,50 @@ def _same_elements(model: Model, source: bytes) -> Found | None:
         root, parse_quirks = xmlsource.parse(normalized, model.path)
     except (UserError, RecursionError):
         return None
-    old_root = model.root
+    old_root, old = model.root, model.source_bytes
     if quirks or parse_quirks or normalized != source or root.tag != old_root.tag or root.nsmap != old_root.nsmap \
-            or dict(root.attrib) != dict(old_root.attrib) or list(root.keys()) != list(old_root.keys()):
+            or list(root.items()) != list(old_root.items()) or _outside(old_root) != _outside(root):
+        return None  # <robot>'s attributes, or a comment before or after it, changed
+    old_items, new_items = list(old_root), list(root)
+    if len(old_items) != len(new_items) or any(a.tag != b.tag for a, b in zip(old_items, new_items)):
         return None
-    if _outside(old_root) != _outside(root):
-        return None  # a comment before or after <robot> changed
-    old_nodes, new_nodes = list(old_root.iter()), list(root.iter())
-    if len(old_nodes) != len(new_nodes) or any(a.tag != b.tag for a, b in zip(old_nodes, new_nodes)):
-        return None
-    changed = []
-    for old_item, new_item in zip(old_root, root):
-        if etree.tostring(old_item, with_tail=False) == etree.tostring(new_item, with_tail=False):
+    start, old_end, new_end = _changed_span(old, source)
+    first, last = old.count(b"\n", 0, start) + 1, old.count(b"\n", 0, old_end) + 1
+    shift = source.count(b"\n", start, new_end) - (last - first)
+    lines = [old_root.sourceline or 0, *(item.sourceline or 0 for item in old_items), float("inf")]
+    compared, moved = [], []
+    for index, (old_item, new_item) in enumerate(zip(old_items, new_items)):
+        if lines[index + 2] < first:
+            continue  # wholly before the edit: the same
+        if lines[index] > last:
+            moved.append(old_item)  # wholly after: the same, moved down or up
             continue
         pairs = list(zip(old_item.iter(), new_item.iter()))
-        if any(a.nsmap != b.nsmap or isinstance(a, etree._ProcessingInstruction) for a, b in pairs) \
-                or [a.get("filename") for a in old_item.iter("mesh")] != [b.get("filename") for b in new_item.iter("mesh")]:
+        if len(pairs) != sum(1 for _ in old_item.iter()) or len(pairs) != sum(1 for _ in new_item.iter()) \
+                or any(a.tag != b.tag or a.nsmap != b.nsmap for a, b in pairs):
             return None
-        changed.append((old_item, pairs))
-    for a, b in zip(old_nodes, new_nodes):
-        if a.sourceline != b.sourceline:
-            a.sourceline = b.sourceline
-    old_root.text = root.text
-    for old_item, new_item in zip(old_root, root):
+        content = etree.tostring(old_item, with_tail=False) != etree.tostring(new_item, with_tail=False)
+        if content and (any(isinstance(a, etree._ProcessingInstruction) for a, _b in pairs)
+                        or [a.get("filename") for a in old_item.iter("mesh")] !=
+                        [b.get("filename") for b in new_item.iter("mesh")]):
+            return None
+        compared.append((old_item, new_item, pairs, content))
+    old_root.sourceline, old_root.text = root.sourceline, root.text
+    if shift:
+        for item in moved:
+            for node in item.iter():
+                node.sourceline += shift
+    for old_item, new_item, pairs, content in compared:
         old_item.tail = new_item.tail
-    for _item, pairs in changed:
         for a, b in pairs:
-            a.text, a.tail = b.text, b.tail
-            if isinstance(a.tag, str) and list(a.items()) != list(b.items()):
-                a.attrib.clear()
-                for key, value in b.items():
-                    a.set(key, value)
-    return [item for item, _pairs in changed], _indexes(model)
+            a.sourceline = b.sourceline
+            if content:
+                a.text, a.tail = b.text, (b.tail if a is not old_item else a.tail)
+                if isinstance(a.tag, str) and list(a.items()) != list(b.items()):
+                    a.attrib.clear()
+                    for key, value in b.items():
+                        a.set(key, value)
+    return [old_item for old_item, _new, _pairs, content in compared if content], _indexes(model)
 
 
 def _outside(root: Any) -> list[bytes]:
