@@ -15,7 +15,8 @@ A keystroke in a value is what the server checks fastest: it makes the new model
 and reuses the earlier check's work (``ar3cli/urdf/model_edit.py``, ``ar3cli/lint/reuse.py``). Two more
 kinds are timed, each in a server process of its own (:data:`KINDS`): a line break typed after a
 ``</joint>`` or deleted (every element below moves: the buffer is parsed and its new lines copied into the
-model), and an element pasted or deleted (a full load, every rule). Last, an in-process breakdown of a
+model), and a comment pasted or deleted (a node more or less, as an element added: a full load, every
+rule). Last, an in-process breakdown of a
 full check and of a keystroke in a value (load, rules, diagnostics).
 
 Alternating with each keystroke, the same file is linted by a whole ``ar3cli lint-urdf --no-cache``
@@ -192,8 +193,9 @@ class Insertions:
     """Keystrokes that insert ``inserted`` at each ``</joint>`` (after it, or before it with ``before``), another
     joint each time and the insertions kept, then, once every joint has one, delete them again in the same
     order: no two texts are the same. A line break after ``</joint>`` moves every element below it (the server
-    parses the buffer and copies the new lines into the model it has); an element pasted before it adds an
-    element (the server loads the buffer and runs every rule in full)."""
+    parses the buffer and copies the new lines into the model it has); a comment pasted before it adds a
+    node, as a new element does (the server loads the buffer and runs every rule in full; a comment changes no
+    finding, on any robot)."""
 
     def __init__(self, text: str, inserted: str, before: bool = False) -> None:
         self.text, self.inserted, self.before = text, inserted, before
@@ -227,8 +229,8 @@ class Insertions:
 
 KINDS = {"a line break after a `</joint>`, or that empty line deleted (every later element moves: the buffer is "
          "parsed, its new lines copied into the model the server has)": ("\n", False),
-         "a `<dynamics damping=\"0.1\"/>` pasted before a `</joint>`, or deleted (an element more or less: a full "
-         "load and every rule)": ('<dynamics damping="0.1"/>', True)}
+         "a comment `<!-- checked -->` pasted before a `</joint>`, or deleted (a node more or less, as an element "
+         "added: a full load and every rule)": ("<!-- checked -->", True)}
 """The keystrokes timed besides those in a value: what they do, and (inserted text, before ``</joint>``)."""
 
 
