@@ -142,6 +142,25 @@ def test_anything_else_is_a_full_load(tmp_path, old, new, why):
     assert not model.edited_away, why
 
 
+@pytest.mark.parametrize("text, old, new, why", [
+    (ARM.replace('<link name="base">', '<link name="base"><visual name="x a:b"/>'), 'name="x a:b"', 'name="x a:b="',
+     "a value the load reads as a namespace prefix (a:b=): it declares xmlns:a and says so (F005)"),
+    (ARM.replace('<?xml version="1.0"?>', '<?xml version="1.0" encoding="us-ascii"?>'), 'name="shoulder"',
+     'name="shoulderé"', "a character the declared encoding lacks: the parser refuses the file"),
+    ('<?xml version="1.0"?>\n<robot name="r">\n  <link name="base"><visual name="v"><geometry><box size="1 1 1"/>'
+     '</geometry></visual></link>\n</robot>\n', 'name="v"', 'name="' + "x" * 10_000_001 + '"',
+     "a value libxml2 refuses here without huge_tree (over 10,000,000 bytes)"),
+    (ARM.replace('<robot name="arm">\n', '<robot name="arm"><link name="x"><robot name="arm"/></link>'),
+     '<robot name="arm"><link', '<robot name="arms"><link', "<robot>'s start tag, with an element alike on its line"),
+])
+def test_edits_a_load_reads_otherwise_are_full_loads(tmp_path, text, old, new, why):
+    """Found by a review: each was taken as an edit and gave another model or other findings than a load."""
+    _path, model = _load(tmp_path, text)
+    assert old in text, why
+    assert edited(model, text.replace(old, new, 1).encode("utf-8")) is None, why
+    assert not model.edited_away, why
+
+
 def test_elements_alike_on_one_line_are_told_apart_by_a_parse_and_files_with_quirks_are_full_loads(tmp_path):
     limit = '<limit lower="-1.57" upper="1.57" effort="10" velocity="1"/>'
     twins = ARM.replace(limit, limit + limit.replace("-1.57", "-2"))

@@ -38,8 +38,12 @@ _START_TAG = re.compile(rb"<[A-Za-z_][\w.\-]*(?:\s+[^\s=/>\"'<]+\s*=\s*(?:\"[^\"
 _ATTRIBUTE = re.compile(rb"\s([^\s=/>\"'<]+)\s*=\s*(?:\"([^\"<]*)\"|'([^'<]*)')")
 _NOT_IN_VALUE = frozenset(b"<>&\"'")
 """Bytes an edit may not type or delete: markup, an entity reference, a quote (control bytes neither)."""
-_REWRITTEN_IN_VALUE = (b"&", b"\t", b"\n", b"\r")
-"""What the parser does not keep as written in an attribute value (entities, whitespace turned to spaces)."""
+_REWRITTEN_IN_VALUE = (b"&", b"\t", b"\n", b"\r", b":")
+"""What the parser, or the load, does not keep as written in an attribute value: entities, whitespace turned
+to spaces, and a colon (``a:b=`` in a value makes the load declare the prefix ``a``: an F005 quirk)."""
+_LONGEST_VALUE = 1 << 20
+"""Bytes of the longest value set without a parse: libxml2 refuses one over 10,000,000 (no ``huge_tree``)."""
+_DECLARED_ENCODING = re.compile(rb"\A\s*<\?xml[^>]*?\bencoding\s*=\s*[\"']([^\"']*)")
 
 
 @dataclass(frozen=True)
@@ -70,7 +74,6 @@ def edited(model: Model, source: bytes) -> Edit | None:
     if found is None:
         return None
     changed, objects = found
-    model.edited_away = True
     before, after, kinds = [], [], {"link": list(model.links), "joint": list(model.joints)}
     for item in changed:
         objects_of_kind = kinds.get(item.tag)
@@ -98,6 +101,9 @@ def _one_value(model: Model, source: bytes) -> Found | None:
     """One attribute value of one element inside a link or joint changed: set it (the tree is changed only
     when this answers)."""
     old = model.source_bytes
+    declared = _DECLARED_ENCODING.match(source)
+    if declared and declared.group(1).lower() not in (b"utf-8", b"utf8"):
+        return None  # a character the declared encoding lacks is the parser's to refuse (us-ascii)
     start, old_end, new_end = _changed_span(old, source)
     if not (_plain(old[start:old_end]) and _plain(source[start:new_end])):
         return None
@@ -107,7 +113,8 @@ def _one_value(model: Model, source: bytes) -> Found | None:
     tag, name, value_start, value_end, tag_end = place
     new_value = source[value_start:value_end]
     old_value = old[value_start:value_end - (new_end - old_end)]
-    if any(mark in value for value in (old_value, new_value) for mark in _REWRITTEN_IN_VALUE):
+    if len(new_value) > _LONGEST_VALUE or any(mark in value for value in (old_value, new_value)
+                                              for mark in _REWRITTEN_IN_VALUE):
         return None
     element = _element_at(model, source.count(b"\n", 0, tag_end) + 1, tag.decode("ascii"), name.decode("utf-8"),
                           old_value.decode("utf-8"))
@@ -119,6 +126,7 @@ def _one_value(model: Model, source: bytes) -> Found | None:
     objects = _indexes(model)
     if item.getparent() is not model.root or id(item) not in objects:
         return None
+    model.edited_away = True  # before the tree changes: a reader on another thread sees it is not its text
     element.set(name.decode("utf-8"), new_value.decode("utf-8"))
     return [item], objects
 
@@ -169,6 +177,7 @@ def _same_elements(model: Model, source: bytes) -> Found | None:
                         [b.get("filename") for b in new_item.iter("mesh")]):
             return None
         compared.append((old_item, new_item, pairs, content))
+    model.edited_away = True  # before the tree changes: a reader on another thread sees it is not its text
     old_root.sourceline, old_root.text = root.sourceline, root.text
     if shift:
         for item in moved:
@@ -270,4 +279,6 @@ def _element_at(model: Model, line: int, tag: str, name: str, value: str) -> Any
         first -= 1
     found = [element for item in items[first:last + 1] for element in item.iter(tag)
              if element.sourceline == line and element.get(name) == value]
+    if model.root.tag == tag and model.root.sourceline == line and model.root.get(name) == value:
+        found.append(model.root)  # <robot>'s own start tag: never taken for an element that looks the same
     return found[0] if len(found) == 1 else None
