@@ -277,3 +277,28 @@ def test_findings_at_one_place_come_in_one_order_after_a_keystroke(tmp_path):
                      for finding in static_findings(RobotAnalysis.load(path, settings, typed)).findings]
     assert [message for _line, _column, rule, message in found if rule == "I005"] == sorted(
         message for _line, _column, rule, message in found if rule == "I005") and len(found) >= 2
+
+
+def test_a_bug_in_the_shortcut_costs_its_speed_never_the_findings(tmp_path, monkeypatch):
+    from ar3cli.analysis.findings import static_findings
+    from ar3cli.analysis.robot import RobotAnalysis
+    from ar3cli.analysis.settings import AnalysisSettings
+    from ar3cli.lint import reuse
+    from ar3cli.urdf import model_edit
+
+    path, settings = tmp_path / "arm.urdf", AnalysisSettings()
+    typed = ARM.replace('upper="1.57" effort', 'upper="-2" effort')  # J003: inverted
+
+    def broken(*_args, **_kwargs):
+        raise RuntimeError("a bug")
+
+    expected = static_findings(RobotAnalysis.load(path, settings, typed)).document
+    for target, name in ((reuse.Reuse, "hits"), (model_edit, "_same_elements"), (model_edit, "_one_value")):
+        earlier = RobotAnalysis.load(path, settings, ARM, editing=True)
+        static_findings(earlier)
+        with monkeypatch.context() as patched:
+            patched.setattr(target, name, broken)
+            analysis = RobotAnalysis.load(path, settings, typed, earlier=earlier, editing=True)
+            document = static_findings(analysis).document
+        assert document == expected, name
+        assert any(finding["rule"] == "J003" for finding in document["findings"])

@@ -112,7 +112,10 @@ class RobotAnalysis:
         robot_file = robot_file_state(path) if source is None else {}
         model, error = None, None
         if editing and earlier is not None and source is not None and len(source) <= MAX_FILE_BYTES:
-            edited = cls._edited(path, settings, source, earlier)
+            try:
+                edited = cls._edited(path, settings, source, earlier)
+            except Exception:  # noqa: BLE001 - a bug in the shortcut costs its speed, never the check: load in full
+                edited = None
             if edited is not None:
                 return edited
         try:

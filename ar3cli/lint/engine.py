@@ -549,7 +549,7 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions, reuse
             if rule.check is None:
                 continue
             try:
-                known = reuse.hits(rule) if reuse is not None and rule.code in ITEM_LOCAL else None
+                known = _reused(reuse, rule) if reuse is not None and rule.code in ITEM_LOCAL else None
                 produced: list[Hit] = []
                 for hit in known if known is not None else rule.check(context):
                     produced.append(hit)
@@ -570,6 +570,17 @@ def _run_rules(model, shown: str, rules: list[Rule], options: LintOptions, reuse
     finally:
         context.close()
     return findings, suppressed, failures
+
+
+def _reused(reuse: Reuse, rule: Rule) -> list[Hit] | None:
+    """``rule``'s hits from the earlier check (:meth:`~ar3cli.lint.reuse.Reuse.hits`), or None: run it in full
+    (also when reusing fails: a bug there costs the reuse, never the rule's findings)."""
+    try:
+        return reuse.hits(rule)
+    except (UserError, MemoryError):
+        raise
+    except Exception:  # noqa: BLE001
+        return None
 
 
 def internal_error(where: str, exc: BaseException) -> str:
