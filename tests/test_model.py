@@ -75,6 +75,13 @@ def test_typed_views(write_urdf):
     assert model.column_of(model.joint("j1").element) == 3
 
 
+def test_elements_alike_on_one_line_each_have_their_own_column(write_urdf):
+    """The column was the first ``<link`` of the line for every link on it: findings on the second were
+    placed (and an editor's underline drawn) on the first."""
+    model = load_model(write_urdf('<robot name="r">\n  <link name="a"/><links/><link name="b"/>\n</robot>\n'))
+    assert [model.column_of(link.element) for link in model.links] == [3, 27]
+
+
 @pytest.mark.parametrize(
     ("mangle", "quirk"),
     [

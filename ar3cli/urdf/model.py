@@ -398,12 +398,32 @@ class Model:
         return xmlsource.decode_text(self.xml_bytes).splitlines()
 
     def column_of(self, element) -> int:
-        """1-based column of the element's start tag on its line (1 when it cannot be found)."""
+        """1-based column of the element's start tag on its line (1 when it cannot be found). Of several
+        elements with one tag on a line (``<link .../><link .../>``), each its own: the n-th ``<tag``."""
         line = element.sourceline or 0
         if not 1 <= line <= len(self.text_lines):
             return 1
-        index = self.text_lines[line - 1].find(f"<{element.tag}")
-        return index + 1 if index >= 0 else 1
+        text = self.text_lines[line - 1]
+        index = text.find(f"<{element.tag}")
+        if index < 0:
+            return 1
+        if text.find(f"<{element.tag}", index + 1) >= 0:  # several on the line (rare): this one's own
+            starts = [match.start() + 1 for match in re.finditer(f"<{re.escape(element.tag)}(?=[\\s/>]|$)", text)]
+            nth = self._alike_on_line.get(element, 0)
+            return starts[nth] if nth < len(starts) else index + 1
+        return index + 1
+
+    @cached_property
+    def _alike_on_line(self) -> dict[Any, int]:
+        """Each element -> how many elements with its tag end their start tag on its line before it."""
+        seen: dict[tuple[int, Any], int] = {}
+        nth: dict[Any, int] = {}
+        for element in self.root.iter():
+            if isinstance(element.tag, str):
+                key = (element.sourceline or 0, element.tag)
+                nth[element] = seen.get(key, 0)
+                seen[key] = nth[element] + 1
+        return nth
 
 
 SRDF_ELEMENTS = frozenset({"group", "group_state", "disable_collisions", "enable_collisions", "disable_default_collisions",
