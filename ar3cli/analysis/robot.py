@@ -98,10 +98,11 @@ class RobotAnalysis:
         limits as lint apply: the capped reader (and the same cap on ``text``), no entities, xacro in
         the process's policy (safe mode unless the front-end chose trusted) in a limited child.
         ``earlier`` is the analysis this one replaces: a load that fails keeps watching its files.
-        ``editing`` (an editor's buffer, checked again on each keystroke): when ``text`` is ``earlier``'s
-        with one attribute value of one link or joint changed, and no file it read changed since, the model
-        is made from ``earlier``'s (:func:`~ar3cli.urdf.model_edit.edited`, which consumes it) and the static
-        findings reuse ``earlier``'s work (:mod:`ar3cli.lint.reuse`); the same model and findings as a load.
+        ``editing`` (an editor's buffer, checked again on each keystroke): when ``text`` is ``earlier``'s with
+        its elements kept (a value, a line break, an indent, a comment changed) and no file it read changed
+        since, the model is made from ``earlier``'s (:func:`~ar3cli.urdf.model_edit.edited`, which consumes it)
+        and the static findings reuse ``earlier``'s work (:mod:`ar3cli.lint.reuse`); the same model and
+        findings as a load.
         """
         from ar3cli.infra.safe_read import MAX_FILE_BYTES
         from ar3cli.urdf.model import load_model

@@ -55,29 +55,28 @@ class Context:
         self.targets = targets
         """The engines the robot is meant for (``lint-urdf --target``): a rule whose verdict depends on
         the engine (a mesh MuJoCo finds through its own ``meshdir``) asks here."""
-        self._bounds: dict[Any, Box | None] = {}
-        """Per link (``id(link)``; the model, and with it every link, lives as long as this context)."""
         self._shape_bounds: dict[int, Box | None] = {}
         self._mesh_bounds: dict[tuple, Box | None] = {}
         self._session: Any = None
         self._shared: dict[str, Any] = {}
         self._link_memos: dict[str, dict[Any, Any]] = {}
+        """Answers about one link each, by ``id(link)`` (the model, and with it every link, lives as long as
+        this context): its boxes (not by name: two links may share one, S002), radius of gyration, density."""
         self._structure: dict[str, Any] = {}
 
     def inherit(self, earlier: Context, kept: list[Link]) -> None:
-        """Start from what ``earlier`` (the check of the text before an edit of one attribute value) computed
-        about the links in ``kept`` and their shapes, the objects the edit did not touch, the same in both
-        models (:mod:`ar3cli.lint.reuse`), and about the tree's structure (:meth:`structure`)."""
+        """Start from what ``earlier`` (the check of the text before an edit that kept every element: a value,
+        a line break) computed about the links in ``kept`` and their shapes, the objects the edit did not
+        touch, the same in both models (:mod:`ar3cli.lint.reuse`), and about the tree's structure
+        (:meth:`structure`)."""
         link_ids = {id(link) for link in kept}
         shape_ids = {id(shape) for link in kept for shape in (*link.visuals, *link.collisions)}
         self._shape_bounds = {key: box for key, box in earlier._shape_bounds.items() if key in shape_ids}
         self._mesh_bounds = dict(earlier._mesh_bounds)  # by file and scale: a changed file is a full check
-        self._bounds = {key: box for key, box in earlier._bounds.items()
-                        if (key[1] if isinstance(key, tuple) else key) in link_ids}
         self._link_memos = {name: {key: value for key, value in memo.items()
                                    if (key[0] if isinstance(key, tuple) else key) in link_ids}
                             for name, memo in earlier._link_memos.items()}
-        self._structure = dict(earlier._structure)  # an edit of a value changes no element, tag or child list
+        self._structure = dict(earlier._structure)  # such an edit changes no element, tag or child list
 
     def disabled_pairs(self) -> tuple[DisabledPairs, str | None]:
         """(the link pairs MoveIt is told not to check, a note saying where they come from or None): the
@@ -115,21 +114,21 @@ class Context:
 
     def link_bounds(self, link: Link) -> Box | None:
         """Box around the link's collision (else visual) shapes in its frame, or None."""
-        key = id(link)  # not its name: two links may share one (S002), each has its own shapes
-        if key not in self._bounds:
-            self._bounds[key] = link_bounds(link, self.shape_bounds)
-        return self._bounds[key]
+        known = self.link_memo("link-bounds")
+        if id(link) not in known:
+            known[id(link)] = link_bounds(link, self.shape_bounds)
+        return known[id(link)]
 
     def body_bounds(self, link: Link) -> Box | None:
         """Box around every visual and collision shape of the link, in its frame, or None: the body's extent
         whichever of its shapes stands for it (Baxter's screen collides as a 1 mm placeholder sphere and is
         drawn as its real 27 cm body). What a radius of gyration is judged against (I007)."""
-        key = ("body", id(link))
-        if key not in self._bounds:
+        known = self.link_memo("body-bounds")
+        if id(link) not in known:
             boxes = [box for shape in (*link.visuals, *link.collisions) if (box := self.shape_bounds(shape)) is not None]
             finite = boxes and all(all(map(math.isfinite, corner)) for box in boxes for corner in box)
-            self._bounds[key] = box_union(boxes) if finite else None
-        return self._bounds[key]
+            known[id(link)] = box_union(boxes) if finite else None
+        return known[id(link)]
 
     def shape_bounds(self, shape: Shape) -> Box | None:
         """Box around one visual or collision shape in its link's frame, or None; computed once per

@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING, Any
 from ar3cli.lint.context import Context
 from ar3cli.lint.rules.base import Hit
 from ar3cli.urdf.model import read_joint, read_link
+from ar3cli.urdf.model_edit import item_of
 
 if TYPE_CHECKING:
     from ar3cli.lint.rules.base import Rule
@@ -131,16 +132,6 @@ def item_hits(rule: Rule, alone: tuple[Model, Any], context: Context, item: Any)
             return None
         mapped.append(replace(hit, element=_follow(item, path)))
     return mapped
-
-
-def item_of(element: Any, root: Any) -> Any:
-    """The child of ``root`` that holds ``element`` (or is it), or None (``root`` itself, no element)."""
-    if element is None:
-        return None
-    parent = element.getparent()
-    while parent is not None and parent is not root:
-        element, parent = parent, parent.getparent()
-    return element if parent is root else None
 
 
 def item_model(model: Model, item: Any) -> tuple[Model, Any]:

@@ -68,9 +68,10 @@ def edited(model: Model, source: bytes) -> Edit | None:
     if source == model.source_bytes or b"<!DOCTYPE" in source or b"<![CDATA[" in source or b"\r" in source \
             or b"\x00" in source or source.startswith(b"\xef\xbb\xbf"):
         return None
-    found = _one_value(model, source)
+    span = _changed_span(model.source_bytes, source)
+    found = _one_value(model, source, span)
     if found is None:
-        found = _same_elements(model, source)
+        found = _same_elements(model, source, span)
     if found is None:
         return None
     changed, objects = found
@@ -89,6 +90,8 @@ def edited(model: Model, source: bytes) -> Edit | None:
     return Edit(new_model, tuple(changed), tuple(before), tuple(after))
 
 
+Span = tuple[int, int, int]
+"""(start, end in the earlier text, end in the new text) of the bytes an edit changed (:func:`_changed_span`)."""
 Found = tuple[list[Any], dict[int, int]]
 """(the changed children of ``<robot>``, and id of each link or joint element -> its index in its list)."""
 
@@ -97,14 +100,24 @@ def _indexes(model: Model) -> dict[int, int]:
     return {id(thing.element): index for things in (model.links, model.joints) for index, thing in enumerate(things)}
 
 
-def _one_value(model: Model, source: bytes) -> Found | None:
+def item_of(element: Any, root: Any) -> Any:
+    """The child of ``root`` that holds ``element`` (or is it), or None (``root`` itself, no element, another tree)."""
+    if element is None:
+        return None
+    parent = element.getparent()
+    while parent is not None and parent is not root:
+        element, parent = parent, parent.getparent()
+    return element if parent is root else None
+
+
+def _one_value(model: Model, source: bytes, span: Span) -> Found | None:
     """One attribute value of one element inside a link or joint changed: set it (the tree is changed only
     when this answers)."""
     old = model.source_bytes
     declared = _DECLARED_ENCODING.match(source)
     if declared and declared.group(1).lower() not in (b"utf-8", b"utf8"):
         return None  # a character the declared encoding lacks is the parser's to refuse (us-ascii)
-    start, old_end, new_end = _changed_span(old, source)
+    start, old_end, new_end = span
     if not (_plain(old[start:old_end]) and _plain(source[start:new_end])):
         return None
     place = _attribute_at(source, start, new_end)
@@ -120,18 +133,16 @@ def _one_value(model: Model, source: bytes) -> Found | None:
                           old_value.decode("utf-8"))
     if element is None:
         return None
-    item = element
-    while item.getparent() is not None and item.getparent() is not model.root:
-        item = item.getparent()
+    item = item_of(element, model.root)
     objects = _indexes(model)
-    if item.getparent() is not model.root or id(item) not in objects:
+    if id(item) not in objects:
         return None
     model.edited_away = True  # before the tree changes: a reader on another thread sees it is not its text
     element.set(name.decode("utf-8"), new_value.decode("utf-8"))
     return [item], objects
 
 
-def _same_elements(model: Model, source: bytes) -> Found | None:
+def _same_elements(model: Model, source: bytes, span: Span) -> Found | None:
     """The new text's tree has the earlier one's nodes and tags: copy its source lines, and the texts and
     attributes of the items whose content changed, into the earlier tree (changed only when this answers).
 
@@ -156,7 +167,7 @@ def _same_elements(model: Model, source: bytes) -> Found | None:
     old_items, new_items = list(old_root), list(root)
     if len(old_items) != len(new_items) or any(a.tag != b.tag for a, b in zip(old_items, new_items)):
         return None
-    start, old_end, new_end = _changed_span(old, source)
+    start, old_end, new_end = span
     first, last = old.count(b"\n", 0, start) + 1, old.count(b"\n", 0, old_end) + 1
     shift = source.count(b"\n", start, new_end) - (last - first)
     lines = [old_root.sourceline or 0, *(item.sourceline or 0 for item in old_items), float("inf")]
@@ -167,9 +178,9 @@ def _same_elements(model: Model, source: bytes) -> Found | None:
         if lines[index] > last:
             moved.append(old_item)  # wholly after: the same, moved down or up
             continue
-        pairs = list(zip(old_item.iter(), new_item.iter()))
-        if len(pairs) != sum(1 for _ in old_item.iter()) or len(pairs) != sum(1 for _ in new_item.iter()) \
-                or any(a.tag != b.tag or a.nsmap != b.nsmap for a, b in pairs):
+        old_nodes, new_nodes = list(old_item.iter()), list(new_item.iter())
+        pairs = list(zip(old_nodes, new_nodes))
+        if len(old_nodes) != len(new_nodes) or any(a.tag != b.tag or a.nsmap != b.nsmap for a, b in pairs):
             return None
         content = etree.tostring(old_item, with_tail=False) != etree.tostring(new_item, with_tail=False)
         if content and (any(isinstance(a, etree._ProcessingInstruction) for a, _b in pairs)
@@ -188,7 +199,7 @@ def _same_elements(model: Model, source: bytes) -> Found | None:
         for a, b in pairs:
             a.sourceline = b.sourceline
             if content:
-                a.text, a.tail = b.text, (b.tail if a is not old_item else a.tail)
+                a.text, a.tail = b.text, b.tail
                 if isinstance(a.tag, str) and list(a.items()) != list(b.items()):
                     a.attrib.clear()
                     for key, value in b.items():
